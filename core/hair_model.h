@@ -1,0 +1,77 @@
+// The interface every hair model implements (DESIGN.md, "Model interface").
+#pragma once
+
+#include "core/groom.h"
+#include "core/params.h"
+#include "core/types.h"
+
+#include <array>
+#include <chrono>
+#include <span>
+#include <string_view>
+
+namespace hairbench {
+
+class ThreadPool;
+
+// Wall time per named solver stage within one step. Fixed capacity and no allocation:
+// it is filled inside the timed step.
+class StageTimes {
+ public:
+  static constexpr std::size_t kMaxStages = 12;
+  struct Entry {
+    std::string_view name;
+    double ms = 0.0;
+  };
+  void add(std::string_view name, double ms) {
+    for (std::size_t i = 0; i < count_; ++i)
+      if (entries_[i].name == name) {
+        entries_[i].ms += ms;
+        return;
+      }
+    if (count_ < kMaxStages) entries_[count_++] = {name, ms};
+  }
+  void clear() { count_ = 0; }
+  std::span<const Entry> entries() const { return {entries_.data(), count_}; }
+
+ private:
+  std::array<Entry, kMaxStages> entries_{};
+  std::size_t count_ = 0;
+};
+
+// Times the scope it lives in and adds it to a stage.
+class StageTimer {
+ public:
+  StageTimer(StageTimes& times, std::string_view stage)
+      : times_(times), stage_(stage), start_(std::chrono::steady_clock::now()) {}
+  ~StageTimer() {
+    const auto end = std::chrono::steady_clock::now();
+    times_.add(stage_, std::chrono::duration<double, std::milli>(end - start_).count());
+  }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  StageTimes& times_;
+  std::string_view stage_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// What a model may use besides its input: the harness's worker threads.
+struct ModelContext {
+  ThreadPool* pool = nullptr;
+};
+
+class HairModel {
+ public:
+  virtual ~HairModel() = default;
+  // Takes the rest groom (head rest frame) and the resolved parameters; the hair starts
+  // at rest under the identity head transform.
+  virtual void reset(const Groom& rest, const ParamSet& params) = 0;
+  // Advances by in.dt. Adds per-stage wall times to out_times.
+  virtual void step(const FrameInput& in, StageTimes& out_times) = 0;
+  // Same topology as the groom given to reset(): strand s, vertex i, world space.
+  virtual std::span<const Vec4f> positions() const = 0;
+};
+
+}  // namespace hairbench

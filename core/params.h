@@ -1,0 +1,56 @@
+// Model parameters: each model declares its parameters (name, default, range) in its
+// settings.h; a ParamSet holds one model's resolved values, with per-region overrides
+// (Han & Harada §5: regions with their own stiffness and iteration counts).
+#pragma once
+
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hairbench {
+
+struct ParamSpec {
+  std::string_view name;
+  double default_value;
+  double min;
+  double max;
+  bool integer;
+  std::string_view help;
+};
+
+class ParamSet {
+ public:
+  ParamSet() = default;
+  ParamSet(std::span<const ParamSpec> specs, std::size_t region_count);
+
+  // Value for a region: the region's override if any, else the base value.
+  double get(std::string_view name, std::size_t region) const;
+  int get_int(std::string_view name, std::size_t region) const {
+    return static_cast<int>(get(name, region));
+  }
+  // Base value; for reports and region-free parameters.
+  double get(std::string_view name) const;
+
+  // Both setters check that the name exists and the value is finite, in range and
+  // integral where required, and throw InputError("where", name, why) otherwise.
+  void set(std::string_view name, double value, const std::string& where);
+  void set_region(std::size_t region, std::string_view name, double value, const std::string& where);
+  // Sets the base value and drops every region override of `name` (command-line
+  // --set wins over everything a file says).
+  void set_everywhere(std::string_view name, double value, const std::string& where);
+
+  bool has(std::string_view name) const;
+  const std::map<std::string, double, std::less<>>& base() const { return base_; }
+  const std::vector<std::map<std::string, double, std::less<>>>& regions() const { return region_; }
+  std::span<const ParamSpec> specs() const { return specs_; }
+
+ private:
+  const ParamSpec& spec(std::string_view name, const std::string& where) const;
+  std::span<const ParamSpec> specs_;
+  std::map<std::string, double, std::less<>> base_;
+  std::vector<std::map<std::string, double, std::less<>>> region_;
+};
+
+}  // namespace hairbench

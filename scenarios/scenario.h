@@ -1,0 +1,68 @@
+// A scenario: groom + scripted head motion + colliders + wind + per-model parameters
+// (the scenario file contract of DESIGN.md).
+#pragma once
+
+#include "core/groom.h"
+#include "scenarios/groom_gen.h"
+#include "scenarios/head_motion.h"
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace hairbench {
+
+// Wind over time: a direction and a strength, optionally keyed (piecewise linear in t).
+struct WindScript {
+  Vec3f direction = Vec3f::UnitX();
+  double strength = 0.0;
+  struct Key {
+    double t;
+    double strength;
+  };
+  std::vector<Key> keys;  // sorted by t; when present they replace `strength`
+  Wind at(double t) const;
+  bool ever_active() const;
+};
+
+// Parameter overrides from a scenario file for one model key ("*" or a model name).
+struct ParamOverrides {
+  std::map<std::string, double> base;
+  std::map<std::string, std::map<std::string, double>> regions;  // region name -> values
+};
+
+struct Scenario {
+  std::string name;
+  std::string description;
+  std::filesystem::path source;  // the file it was loaded from ("" if built in code)
+  int frames = 240;
+  double dt = 1.0 / 60.0;
+  Vec3f gravity{0.0f, -9.81f, 0.0f};
+  Groom groom;
+  std::vector<std::map<std::string, double>> region_params;  // per groom region defaults
+  float head_radius = 0.1f;
+  HeadMotion head;
+  std::vector<Sphere> colliders;
+  WindScript wind;
+  double settle_from = 0.0;
+  std::string reference = "han_m1";
+  std::map<std::string, ParamOverrides> models;  // "*" and model names, as in the file
+
+  double duration() const { return frames * dt; }
+};
+
+// Loads and validates a scenario file. Every problem is an InputError with the message
+// "FILE: KEY: what is wrong" (unknown keys, wrong types, missing or non-finite numbers,
+// out-of-range values, missing referenced files).
+Scenario load_scenario(const std::filesystem::path& file);
+
+// The folder of built-in scenarios (scenarios/builtin in the source tree, or
+// $HAIRBENCH_SCENARIO_DIR), and its scenario files sorted by name.
+std::filesystem::path builtin_scenario_dir();
+std::vector<std::filesystem::path> builtin_scenarios();
+
+// A name ("shake") or a path to a JSON file -> the file; InputError if neither exists.
+std::filesystem::path find_scenario(const std::string& name_or_path);
+
+}  // namespace hairbench
