@@ -12,17 +12,19 @@ ParamSet::ParamSet(std::span<const ParamSpec> specs, std::size_t region_count)
   for (const ParamSpec& s : specs_) base_.emplace(std::string(s.name), s.default_value);
 }
 
-const ParamSpec& ParamSet::spec(std::string_view name, const std::string& where) const {
+const ParamSpec& ParamSet::spec(std::string_view name, const Origin& from) const {
   for (const ParamSpec& s : specs_)
     if (s.name == name) return s;
   std::string known;
   for (const ParamSpec& s : specs_) known += (known.empty() ? "" : ", ") + std::string(s.name);
-  throw InputError(where, std::string(name), "unknown parameter (known: " + known + ")");
+  throw InputError(from.file, from.prefix + std::string(name),
+                   "unknown parameter (known: " + known + ")");
 }
 
 namespace {
-void check_value(const ParamSpec& s, double v, const std::string& where) {
-  const std::string field(s.name);
+void check_value(const ParamSpec& s, double v, const ParamSet::Origin& from) {
+  const std::string field = from.prefix + std::string(s.name);
+  const std::string& where = from.file;
   if (!std::isfinite(v)) throw InputError(where, field, "value is NaN or infinite");
   if (v < s.min || v > s.max) {
     std::ostringstream os;
@@ -49,19 +51,19 @@ double ParamSet::get(std::string_view name) const {
 
 bool ParamSet::has(std::string_view name) const { return base_.find(name) != base_.end(); }
 
-void ParamSet::set(std::string_view name, double value, const std::string& where) {
-  check_value(spec(name, where), value, where);
+void ParamSet::set(std::string_view name, double value, const Origin& from) {
+  check_value(spec(name, from), value, from);
   base_.find(name)->second = value;
 }
 
 void ParamSet::set_region(std::size_t region, std::string_view name, double value,
-                          const std::string& where) {
-  check_value(spec(name, where), value, where);
+                          const Origin& from) {
+  check_value(spec(name, from), value, from);
   region_.at(region)[std::string(name)] = value;
 }
 
-void ParamSet::set_everywhere(std::string_view name, double value, const std::string& where) {
-  set(name, value, where);
+void ParamSet::set_everywhere(std::string_view name, double value, const Origin& from) {
+  set(name, value, from);
   for (auto& r : region_) {
     const auto it = r.find(name);
     if (it != r.end()) r.erase(it);

@@ -3,6 +3,7 @@
 // (Han & Harada §5: regions with their own stiffness and iteration counts).
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <span>
 #include <string>
@@ -27,19 +28,24 @@ class ParamSet {
 
   // Value for a region: the region's override if any, else the base value.
   double get(std::string_view name, std::size_t region) const;
-  int get_int(std::string_view name, std::size_t region) const {
+  int get_int(std::string_view name, std::size_t region = SIZE_MAX) const {
     return static_cast<int>(get(name, region));
   }
   // Base value; for reports and region-free parameters.
   double get(std::string_view name) const;
 
-  // Both setters check that the name exists and the value is finite, in range and
-  // integral where required, and throw InputError("where", name, why) otherwise.
-  void set(std::string_view name, double value, const std::string& where);
-  void set_region(std::size_t region, std::string_view name, double value, const std::string& where);
+  // Where a value came from, for error messages: "FILE: PREFIXNAME: why".
+  struct Origin {
+    std::string file;
+    std::string prefix;
+  };
+  // The setters check that the name exists and the value is finite, in range and
+  // integral where required, and throw InputError otherwise.
+  void set(std::string_view name, double value, const Origin& from);
+  void set_region(std::size_t region, std::string_view name, double value, const Origin& from);
   // Sets the base value and drops every region override of `name` (command-line
   // --set wins over everything a file says).
-  void set_everywhere(std::string_view name, double value, const std::string& where);
+  void set_everywhere(std::string_view name, double value, const Origin& from);
 
   bool has(std::string_view name) const;
   const std::map<std::string, double, std::less<>>& base() const { return base_; }
@@ -47,7 +53,7 @@ class ParamSet {
   std::span<const ParamSpec> specs() const { return specs_; }
 
  private:
-  const ParamSpec& spec(std::string_view name, const std::string& where) const;
+  const ParamSpec& spec(std::string_view name, const Origin& from) const;
   std::span<const ParamSpec> specs_;
   std::map<std::string, double, std::less<>> base_;
   std::vector<std::map<std::string, double, std::less<>>> region_;

@@ -6,10 +6,16 @@
 
 #include <cstdint>
 #include <map>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace hairbench {
+
+// The largest groom generate_groom builds (and a scenario file may ask for).
+inline constexpr int kMaxGroomStrands = 1'000'000;
+inline constexpr int kMaxStrandVertices = 256;
 
 struct GroomSpec {
   std::string style = "straight";  // straight | wavy | curly | ponytail
@@ -30,6 +36,9 @@ struct GeneratedGroom {
   // groom.region_names.
   std::vector<std::map<std::string, double>> region_params;
 };
+
+// The styles generate_groom builds, for loaders and error messages.
+std::span<const std::string_view> groom_styles();
 
 // Strands rooted on the upper half of the head sphere (radius head_radius, centre at
 // the origin), growing outward and combed downward, never inside the sphere; vertices 0

@@ -35,7 +35,8 @@ class HeadMotion {
   std::vector<Oscillator> oscillators;
 
   // head rest frame -> world at time t. Keys: slerp of rotation and lerp of translation
-  // between the surrounding keys (held before the first and after the last); then the
+  // between the surrounding keys (held before the first and after the last; two keys
+  // with the same axis interpolate the angle, so a segment may turn past 180°); then the
   // oscillators, in file order, add A*sin(2*pi*f*(t-start)+phase) rotation about the
   // head centre or translation along their axis while start <= t <= end.
   Affine3f at(double t) const;

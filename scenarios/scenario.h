@@ -2,16 +2,27 @@
 // (the scenario file contract of DESIGN.md).
 #pragma once
 
+#include "core/error.h"
 #include "core/groom.h"
 #include "scenarios/groom_gen.h"
 #include "scenarios/head_motion.h"
+#include "scenarios/tfx/tfx.h"
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace hairbench {
+
+// A file the scenario refers to (an imported asset) does not exist. Distinct from other
+// input errors so that the built-in scenarios can skip assets that live outside the
+// repository (../shared) where a clone does not have them.
+class MissingAssetError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 // Wind over time: a direction and a strength, optionally keyed (piecewise linear in t).
 struct WindScript {
@@ -39,7 +50,15 @@ struct Scenario {
   int frames = 240;
   double dt = 1.0 / 60.0;
   Vec3f gravity{0.0f, -9.81f, 0.0f};
+  // The full groom: every strand the metrics cover, follow hairs of an imported asset
+  // included.
   Groom groom;
+  // With an imported asset whose follow hairs are rebuilt from their guides
+  // (groom.follow_hairs "follow"): the follow layout and the guide groom the models
+  // simulate. groom is then `guides` expanded by `follow` (tfx::expand_follow_hairs), and
+  // guides has groom's regions. Unset when models simulate every strand of `groom`.
+  std::optional<tfx::FollowHairs> follow;
+  Groom guides;
   std::vector<std::map<std::string, double>> region_params;  // per groom region defaults
   float head_radius = 0.1f;
   HeadMotion head;
@@ -61,6 +80,11 @@ Scenario load_scenario(const std::filesystem::path& file);
 // $HAIRBENCH_SCENARIO_DIR), and its scenario files sorted by name.
 std::filesystem::path builtin_scenario_dir();
 std::vector<std::filesystem::path> builtin_scenarios();
+
+// Loads every built-in scenario. One whose asset file is missing (MissingAssetError: the
+// TressFX scenarios read ../shared, which a clone may lack) is left out, and its one-line
+// message appended to *skipped when skipped is not null; any other error is thrown.
+std::vector<Scenario> load_builtin_scenarios(std::vector<std::string>* skipped);
 
 // A name ("shake") or a path to a JSON file -> the file; InputError if neither exists.
 std::filesystem::path find_scenario(const std::string& name_or_path);

@@ -1,0 +1,160 @@
+#include "kernels/cpu/strand_kernels.h"
+
+#include "kernels/cpu/frames.h"
+
+#include <cmath>
+
+namespace hairbench::kernels {
+
+namespace {
+Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
+}  // namespace
+
+void follow_head(std::span<Vec4f> pos, std::span<Vec4f> prev, std::span<const Vec4f> rest,
+                 const Affine3f& head) {
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (rest[i].w() != 0.0f) continue;
+    prev[i] = pos[i];
+    pos[i].head<3>() = head * xyz(rest[i]);
+  }
+}
+
+void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& gravity,
+                      const Wind& wind, float damping, float dt) {
+  const float keep = 1.0f - damping;
+  const float dt2 = dt * dt;
+  const Vec3f wind_acc = wind.acceleration();
+  const bool windy = wind.active();
+  for (std::size_t i = 1; i < pos.size(); ++i) {
+    if (pos[i].w() == 0.0f) continue;
+    Vec3f acc = gravity;
+    if (windy) {
+      const Vec3f edge = xyz(pos[i]) - xyz(pos[i - 1]);
+      const float len2 = edge.squaredNorm();
+      const Vec3f t = len2 > 0.0f ? Vec3f(edge / std::sqrt(len2)) : Vec3f::Zero();
+      acc += wind_acc - wind_acc.dot(t) * t;
+    }
+    const Vec3f p = xyz(pos[i]);
+    pos[i].head<3>() = p + keep * (p - xyz(prev[i])) + acc * dt2;
+    prev[i].head<3>() = p;
+  }
+}
+
+void global_shape(std::span<Vec4f> pos, std::span<const Vec4f> rest, const Affine3f& head,
+                  float stiffness, float range, bool ramp) {
+  const float reach = range * static_cast<float>(pos.size());
+  for (std::size_t i = 0; i < pos.size() && static_cast<float>(i) < reach; ++i) {
+    if (pos[i].w() == 0.0f) continue;
+    const float s = ramp ? stiffness * (1.0f - static_cast<float>(i) / reach) : stiffness;
+    const Vec3f goal = head * xyz(rest[i]);
+    pos[i].head<3>() += s * (goal - xyz(pos[i]));
+  }
+}
+
+void init_rest_frames(std::span<const Vec4f> rest, std::span<Quatf> rest_rotation,
+                      std::span<Vec3f> rest_local) {
+  const std::size_t n = rest.size();
+  rest_rotation[0] = root_frame((xyz(rest[1]) - xyz(rest[0])).normalized());
+  rest_local[0] = Vec3f::Zero();
+  for (std::size_t i = 1; i < n; ++i) {
+    const Vec3f edge = xyz(rest[i]) - xyz(rest[i - 1]);
+    const Quatf& parent = rest_rotation[i - 1];
+    rest_local[i] = parent.conjugate() * edge;  // ^{i-1}P_i^0
+    // Algorithm 2 line 8: ^{i-1}T_i^0 is the rotation from (1,0,0) to ^{i-1}x_i^0.
+    rest_rotation[i] = (parent * rotation_from_x(rest_local[i].normalized())).normalized();
+  }
+}
+
+namespace {
+// Frame of vertex i from its parent's frame and the current edge (Algorithm 3, lines
+// 10-12): ^{i-1}x_i = R_{i-1}^T x_i, then R_i = R_{i-1} · rot(x → ^{i-1}x_i).
+Quatf child_frame(const Quatf& parent, const Vec4f& a, const Vec4f& b) {
+  const Vec3f edge = xyz(b) - xyz(a);
+  const float len = edge.norm();
+  if (!(len > 0.0f)) return parent;
+  return (parent * rotation_from_x(parent.conjugate() * (edge / len))).normalized();
+}
+}  // namespace
+
+void local_shape_m1(std::span<Vec4f> pos, std::span<const Quatf> rest_rotation,
+                    std::span<const Vec3f> rest_local, const Quatf& head_rotation, float stiffness) {
+  const std::size_t n = pos.size();
+  if (n < 3) return;
+  // Vertices 0 and 1 are pinned: their frames are the head-transformed rest frames
+  // (Algorithm 3, line 6).
+  Quatf frame = head_rotation * rest_rotation[1];
+  for (std::size_t i = 2; i < n; ++i) {
+    const Vec3f goal = xyz(pos[i - 1]) + frame * rest_local[i];
+    local_shape_edge(pos[i - 1], pos[i], goal, stiffness);
+    frame = child_frame(frame, pos[i - 1], pos[i]);
+  }
+}
+
+void local_shape_m2(std::span<Vec4f> pos, std::span<Quatf> rotation, std::span<Quatf> scratch,
+                    std::span<const Quatf> rest_rotation, std::span<const Vec3f> rest_local,
+                    const Quatf& head_rotation, float stiffness) {
+  const std::size_t n = pos.size();
+  if (n < 3) return;
+  rotation[0] = head_rotation * rest_rotation[0];
+  rotation[1] = head_rotation * rest_rotation[1];
+  // Algorithm 4, line 5: wT_temp_i <- wT_i, then every goal reads only the copy.
+  for (std::size_t i = 0; i < n; ++i) scratch[i] = rotation[i];
+  for (std::size_t first : {std::size_t{2}, std::size_t{3}})
+    for (std::size_t i = first; i < n; i += 2) {
+      const Vec3f goal = xyz(pos[i - 1]) + scratch[i - 1] * rest_local[i];
+      local_shape_edge(pos[i - 1], pos[i], goal, stiffness);
+    }
+  for (std::size_t i = 2; i < n; ++i) rotation[i] = child_frame(scratch[i - 1], pos[i - 1], pos[i]);
+}
+
+void local_shape_m3(std::span<Vec4f> pos, std::span<const Vec4f> rest, const Quatf& head_rotation,
+                    float stiffness) {
+  const std::size_t n = pos.size();
+  for (std::size_t first : {std::size_t{2}, std::size_t{3}})
+    for (std::size_t i = first; i < n; i += 2) {
+      const Vec3f goal = xyz(pos[i - 1]) + head_rotation * (xyz(rest[i]) - xyz(rest[i - 1]));
+      local_shape_edge(pos[i - 1], pos[i], goal, stiffness);
+    }
+}
+
+void edge_length(std::span<Vec4f> pos, std::span<const float> rest_length) {
+  const std::size_t n = pos.size();
+  for (std::size_t first : {std::size_t{1}, std::size_t{2}})
+    for (std::size_t i = first; i < n; i += 2) {
+      Vec4f& a = pos[i - 1];
+      Vec4f& b = pos[i];
+      const float wsum = a.w() + b.w();
+      if (wsum == 0.0f) continue;
+      const Vec3f d = xyz(b) - xyz(a);
+      const float len = d.norm();
+      if (!(len > 0.0f)) continue;
+      const Vec3f corr = d * ((len - rest_length[i]) / (len * wsum));
+      a.head<3>() += a.w() * corr;
+      b.head<3>() -= b.w() * corr;
+    }
+}
+
+void collide_spheres(std::span<Vec4f> pos, std::span<const Vec4f> world_spheres) {
+  if (world_spheres.empty()) return;
+  constexpr int kPasses = 4;
+  for (Vec4f& p : pos) {
+    if (p.w() == 0.0f) continue;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      bool moved = false;
+      for (const Vec4f& s : world_spheres) {
+        const Vec3f d = xyz(p) - xyz(s);
+        const float r = s.w();
+        const float dist2 = d.squaredNorm();
+        if (dist2 >= r * r) continue;
+        const float dist = std::sqrt(dist2);
+        // A vertex exactly at the centre has no closest point; push it straight up.
+        const Vec3f n = dist > 0.0f ? Vec3f(d / dist) : Vec3f::UnitY();
+        p.head<3>() = xyz(s) + n * r;
+        moved = true;
+      }
+      if (!moved) break;
+    }
+  }
+}
+
+}  // namespace hairbench::kernels

@@ -1,0 +1,135 @@
+#include "models/han/model.h"
+
+#include "core/parallel.h"
+#include "kernels/cpu/strand_kernels.h"
+
+#include <algorithm>
+
+namespace hairbench::han {
+
+namespace k = hairbench::kernels;
+
+HanModel::HanModel(Method method, const ModelContext& ctx) : method_(method), ctx_(ctx) {}
+
+void HanModel::reset(const Groom& rest, const ParamSet& params) {
+  rest_ = rest;
+  rest_length_ = rest_edge_lengths(rest);
+  pos_ = rest.positions;
+  prev_ = rest.positions;
+  rest_rotation_.assign(rest.vertex_count(), Quatf::Identity());
+  rest_local_.assign(rest.vertex_count(), Vec3f::Zero());
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
+    k::init_rest_frames(std::span(rest.positions).subspan(b, n),
+                        std::span(rest_rotation_).subspan(b, n), std::span(rest_local_).subspan(b, n));
+  }
+  rotation_ = rest_rotation_;
+  scratch_ = rest_rotation_;
+
+  region_.clear();
+  max_iterations_ = 0;
+  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
+    RegionSettings rs{};
+    rs.damping = static_cast<float>(params.get("damping", r));
+    rs.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
+    rs.global_range = static_cast<float>(params.get("global_range", r));
+    rs.global_ramp = params.get_int("global_ramp", r) != 0;
+    rs.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
+    rs.local_iterations = params.get_int("local_iterations", r);
+    rs.length_iterations = params.get_int("length_iterations", r);
+    max_iterations_ = std::max({max_iterations_, rs.local_iterations, rs.length_iterations});
+    region_.push_back(rs);
+  }
+  substeps_ = params.get_int("substeps");
+}
+
+std::span<Vec4f> HanModel::strand(std::vector<Vec4f>& v, std::size_t s) {
+  return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));
+}
+
+template <class F>
+void HanModel::for_each_strand(F&& f) {
+  ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) f(s, region_[rest_.strand_region[s]]);
+  });
+}
+
+void HanModel::step(const FrameInput& in, StageTimes& times) {
+  const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  for (int k = 1; k <= substeps_; ++k) {
+    const float s = static_cast<float>(k) / static_cast<float>(substeps_);
+    substep(interpolate_head(in.head_prev, in.head, s), in, dt, times);
+  }
+}
+
+// One pass of Algorithm 1.
+void HanModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
+  const Quatf head_rotation(head.rotation());
+  {
+    StageTimer t(times, "integrate");
+    for_each_strand([&](std::size_t s, const RegionSettings& r) {
+      k::follow_head(strand(pos_, s), strand(prev_, s),
+                     std::span<const Vec4f>(rest_.positions).subspan(rest_.strand_begin(s), rest_.strand_size(s)),
+                     head);
+      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, r.damping, dt);
+    });
+  }
+  {
+    StageTimer t(times, "global_shape");
+    for_each_strand([&](std::size_t s, const RegionSettings& r) {
+      const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+      k::global_shape(strand(pos_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n), head,
+                      r.global_stiffness, r.global_range, r.global_ramp);
+    });
+  }
+  // Algorithm 1 lines 7-9: local shape and edge length constraints alternate; each
+  // region stops after its own iteration counts.
+  for (int it = 0; it < max_iterations_; ++it) {
+    {
+      StageTimer t(times, "local_shape");
+      for_each_strand([&](std::size_t s, const RegionSettings& r) {
+        if (it >= r.local_iterations) return;
+        const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+        const auto rest_rot = std::span<const Quatf>(rest_rotation_).subspan(b, n);
+        const auto rest_loc = std::span<const Vec3f>(rest_local_).subspan(b, n);
+        switch (method_) {
+          case Method::Serial:
+            k::local_shape_m1(strand(pos_, s), rest_rot, rest_loc, head_rotation, r.local_stiffness);
+            break;
+          case Method::Jacobi:
+            k::local_shape_m2(strand(pos_, s), std::span(rotation_).subspan(b, n),
+                              std::span(scratch_).subspan(b, n), rest_rot, rest_loc, head_rotation,
+                              r.local_stiffness);
+            break;
+          case Method::RestFrames:
+            k::local_shape_m3(strand(pos_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n),
+                              head_rotation, r.local_stiffness);
+            break;
+        }
+      });
+    }
+    {
+      StageTimer t(times, "length");
+      for_each_strand([&](std::size_t s, const RegionSettings& r) {
+        if (it >= r.length_iterations) return;
+        k::edge_length(strand(pos_, s),
+                       std::span<const float>(rest_length_).subspan(rest_.strand_begin(s), rest_.strand_size(s)));
+      });
+    }
+  }
+  {
+    StageTimer t(times, "collision");
+    spheres_.clear();
+    for (const Sphere& c : in.colliders) {
+      const Vec3f center = collider_center(c, head);
+      spheres_.emplace_back(center.x(), center.y(), center.z(), c.radius);
+    }
+    for_each_strand([&](std::size_t s, const RegionSettings&) { k::collide_spheres(strand(pos_, s), spheres_); });
+  }
+}
+
+std::unique_ptr<HairModel> make_han(Method method, const ModelContext& ctx) {
+  return std::make_unique<HanModel>(method, ctx);
+}
+
+}  // namespace hairbench::han

@@ -1,0 +1,55 @@
+// Han & Harada 2012, "Real-time Hair Simulation with Efficient Hair Style Preservation":
+// Algorithm 1 (integrate, global shape, local shape + edge length iterations, collision)
+// with the three ways of updating the local/global transforms of §4.2.
+#pragma once
+
+#include "core/hair_model.h"
+
+#include <memory>
+#include <vector>
+
+namespace hairbench::han {
+
+enum class Method {
+  Serial = 1,    // method 1, Algorithm 3: exact transforms, serial within a strand
+  Jacobi = 2,    // method 2, Algorithm 4: transforms from the previous iteration
+  RestFrames = 3 // method 3, Algorithm 5: rest-state transforms under the head rotation
+};
+
+class HanModel final : public HairModel {
+ public:
+  HanModel(Method method, const ModelContext& ctx);
+  void reset(const Groom& rest, const ParamSet& params) override;
+  void step(const FrameInput& in, StageTimes& out_times) override;
+  std::span<const Vec4f> positions() const override { return pos_; }
+
+ private:
+  // Per-region solver settings, read once in reset().
+  struct RegionSettings {
+    float damping, global_stiffness, global_range, local_stiffness;
+    int local_iterations, length_iterations;
+    bool global_ramp;
+  };
+  void substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times);
+  template <class F>
+  void for_each_strand(F&& f);
+  std::span<Vec4f> strand(std::vector<Vec4f>& v, std::size_t s);
+
+  Method method_;
+  ModelContext ctx_;
+  Groom rest_;
+  std::vector<float> rest_length_;
+  std::vector<Quatf> rest_rotation_;  // wR_i^0 (Algorithm 2)
+  std::vector<Vec3f> rest_local_;     // ^{i-1}P_i^0
+  std::vector<RegionSettings> region_;
+  int substeps_ = 1;
+  int max_iterations_ = 0;
+
+  std::vector<Vec4f> pos_, prev_;
+  std::vector<Quatf> rotation_, scratch_;  // method 2's persistent frames and their copy
+  std::vector<Vec4f> spheres_;             // world-space colliders of the current substep
+};
+
+std::unique_ptr<HairModel> make_han(Method method, const ModelContext& ctx);
+
+}  // namespace hairbench::han

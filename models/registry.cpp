@@ -1,0 +1,28 @@
+#include "models/registry.h"
+
+#include "models/han/model.h"
+#include "models/han/settings.h"
+
+#include <vector>
+
+namespace hairbench {
+
+std::span<const ModelInfo> model_registry() {
+  static const std::vector<ModelInfo> models = {
+      {"han_m1", "Han & Harada 2012 method 1: serial exact local/global transforms (Algorithm 3)",
+       han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Serial, c); }},
+      {"han_m2", "Han & Harada 2012 method 2: Jacobi transforms from the last iteration (Algorithm 4)",
+       han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Jacobi, c); }},
+      {"han_m3", "Han & Harada 2012 method 3: rest-state transforms (Algorithm 5)",
+       han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::RestFrames, c); }},
+  };
+  return models;
+}
+
+const ModelInfo* find_model(std::string_view name) {
+  for (const ModelInfo& m : model_registry())
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+}  // namespace hairbench

@@ -1,0 +1,139 @@
+#include "reports/metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <iomanip>
+
+namespace hairbench::metrics {
+
+namespace {
+Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
+}  // namespace
+
+RestInfo::RestInfo(const Groom& rest)
+    : groom(&rest), rest_length(rest_edge_lengths(rest)), mean_strand_length(hairbench::mean_strand_length(rest)) {
+  rest_jaggedness.resize(rest.strand_count());
+  for (std::size_t s = 0; s < rest.strand_count(); ++s)
+    rest_jaggedness[s] = strand_jaggedness_raw(
+        std::span(rest.positions).subspan(rest.strand_begin(s), rest.strand_size(s)));
+}
+
+double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) sum += (xyz(p[i]) - xyz(ref[i])).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(p.size())) / mean_length;
+}
+
+namespace {
+// Curvature binormal at vertex i (between edges i-1 -> i and i -> i+1). An exact
+// hairpin (antiparallel edges) has unbounded curvature; the denominator is floored so
+// the metric stays finite and large there.
+Eigen::Vector3d curvature_binormal(const Eigen::Vector3d& e0, const Eigen::Vector3d& e1) {
+  const double lens = e0.norm() * e1.norm();
+  const double denom = std::max(lens + e0.dot(e1), 1e-12 * std::max(lens, 1e-30));
+  return 2.0 * e0.cross(e1) / denom;
+}
+}  // namespace
+
+double strand_jaggedness_raw(std::span<const Vec4f> s) {
+  const std::size_t n = s.size();
+  if (n < 4) return 0.0;
+  double sum = 0.0;
+  Eigen::Vector3d prev = curvature_binormal(xyz(s[1]) - xyz(s[0]), xyz(s[2]) - xyz(s[1]));
+  for (std::size_t i = 2; i + 1 < n; ++i) {
+    const Eigen::Vector3d kb = curvature_binormal(xyz(s[i]) - xyz(s[i - 1]), xyz(s[i + 1]) - xyz(s[i]));
+    sum += (kb - prev).squaredNorm();
+    prev = kb;
+  }
+  return std::sqrt(sum / static_cast<double>(n - 3));
+}
+
+double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
+  const Groom& g = *rest.groom;
+  double sum = 0.0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s)
+    sum += strand_jaggedness_raw(p.subspan(g.strand_begin(s), g.strand_size(s))) - rest.rest_jaggedness[s];
+  return sum / static_cast<double>(g.strand_count());
+}
+
+LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p) {
+  const Groom& g = *rest.groom;
+  LengthError out;
+  double sum = 0.0;
+  std::size_t edges = 0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
+    for (std::size_t i = b + 1; i < b + n; ++i) {
+      const double e = std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
+      sum += e * e;
+      out.max = std::max(out.max, e);
+      ++edges;
+    }
+  }
+  out.rms = edges ? std::sqrt(sum / static_cast<double>(edges)) : 0.0;
+  return out;
+}
+
+double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Affine3f& head) {
+  const Affine3f& h = head;
+  double sum = 0.0;
+  const auto& r = rest.groom->positions;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec3f goal = h * Vec3f(r[i].head<3>());
+    sum += (xyz(p[i]) - goal.cast<double>()).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(p.size())) / rest.mean_strand_length;
+}
+
+double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
+  double deepest = 0.0;
+  for (const Vec4f& s : world_spheres)
+    for (const Vec4f& v : p) deepest = std::max(deepest, double(s.w()) - (xyz(v) - xyz(s)).norm());
+  return deepest;
+}
+
+std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center) {
+  const Groom& g = *rest.groom;
+  const double far = 10.0 * rest.mean_strand_length;
+  const Eigen::Vector3d c = head_center.cast<double>();
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
+    for (std::size_t i = b; i < b + n; ++i) {
+      if (!p[i].allFinite())
+        return "non-finite position (strand " + std::to_string(s) + ", vertex " + std::to_string(i - b) + ")";
+      if ((xyz(p[i]) - c).norm() > far)
+        return "vertex farther than 10 mean strand lengths from the head (strand " + std::to_string(s) + ")";
+      if (i > b) {
+        const double e = std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
+        if (e > 0.5)
+          return "edge length error above 50% (strand " + std::to_string(s) + ", edge " + std::to_string(i - b) + ")";
+      }
+    }
+  }
+  return {};
+}
+
+std::uint64_t state_hash(std::span<const Vec4f> p) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const Vec4f& v : p)
+    for (int k = 0; k < 4; ++k) {
+      std::uint32_t bits;
+      const float f = v[k];
+      std::memcpy(&bits, &f, sizeof bits);
+      for (int byte = 0; byte < 4; ++byte) {
+        h ^= (bits >> (8 * byte)) & 0xffu;
+        h *= 1099511628211ull;
+      }
+    }
+  return h;
+}
+
+std::string hash_hex(std::uint64_t h) {
+  std::ostringstream os;
+  os << std::hex << std::setw(16) << std::setfill('0') << h;
+  return os.str();
+}
+
+}  // namespace hairbench::metrics

@@ -1,0 +1,55 @@
+// The per-frame metrics of DESIGN.md ("Metrics (contract)"). All are computed by the
+// harness from positions alone, so every model is measured by the same code.
+#pragma once
+
+#include "core/groom.h"
+#include "core/types.h"
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace hairbench::metrics {
+
+// What the metrics need of the rest groom, computed once per run.
+struct RestInfo {
+  explicit RestInfo(const Groom& rest);
+  const Groom* groom;
+  std::vector<float> rest_length;        // per edge, indexed by its second vertex
+  double mean_strand_length;             // L-bar
+  std::vector<double> rest_jaggedness;   // per strand, raw (not rest-subtracted)
+};
+
+// sqrt(mean over vertices |p - p_ref|^2) / L-bar.
+double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length);
+
+// sqrt(mean_i |kb_{i+1} - kb_i|^2) of one strand, with the discrete curvature binormal
+// kb_i = 2 (e_{i-1} x e_i) / (|e_{i-1}||e_i| + e_{i-1}.e_i) (Bergou et al. 2008);
+// 0 for strands with fewer than 4 vertices (no pair of binormals).
+double strand_jaggedness_raw(std::span<const Vec4f> strand);
+// Groom jaggedness: mean over strands of (raw - raw on the rest shape).
+double jaggedness(const RestInfo& rest, std::span<const Vec4f> p);
+
+struct LengthError {
+  double rms = 0.0;
+  double max = 0.0;
+};
+// |edge - rest edge| / rest edge over all edges.
+LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p);
+
+// sqrt(mean |p - T_H p^0|^2) / L-bar: deviation from the head-transformed rest shape.
+double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Affine3f& head);
+
+// Deepest vertex inside any sphere (xyz centre, w radius), metres; 0 if none.
+double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres);
+
+// Empty if the state is sane, else why the model is declared unstable: NaN/Inf, an edge
+// stretched or shrunk by more than 50%, or a vertex farther than 10 L-bar from the head.
+std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center);
+
+// 64-bit FNV-1a over the bits of every position (xyzw): bit-exact determinism checks.
+std::uint64_t state_hash(std::span<const Vec4f> p);
+std::string hash_hex(std::uint64_t h);
+
+}  // namespace hairbench::metrics

@@ -1,0 +1,190 @@
+#include "reports/report.h"
+
+#include "reports/metrics.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <numeric>
+#include <thread>
+#include <unistd.h>
+
+namespace hairbench {
+
+namespace {
+
+// NaN and Inf are never bare tokens in the report: they become null (DESIGN.md).
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json series(const std::vector<double>& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (double x : v) a.push_back(num(x));
+  return a;
+}
+
+double finite_max(const std::vector<double>& v) {
+  double m = std::numeric_limits<double>::quiet_NaN();
+  for (double x : v)
+    if (std::isfinite(x)) m = std::isnan(m) ? x : std::max(m, x);
+  return m;
+}
+
+double finite_mean(const std::vector<double>& v) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (double x : v)
+    if (std::isfinite(x)) {
+      sum += x;
+      ++n;
+    }
+  return n ? sum / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
+}
+
+double rms(const std::vector<double>& v) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (double x : v)
+    if (std::isfinite(x)) {
+      sum += x * x;
+      ++n;
+    }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string cpu_name() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
+    }
+  return "unknown";
+}
+
+// The commit being measured: asked of git at run time (the build may be older than
+// HEAD), falling back to the commit seen at configure time.
+std::string git_sha() {
+  std::string sha;
+  if (FILE* p = popen("git -C \"" HAIRBENCH_SOURCE_DIR "\" rev-parse --short=12 HEAD 2>/dev/null", "r")) {
+    char buf[64] = {};
+    if (std::fgets(buf, sizeof buf, p)) sha = buf;
+    pclose(p);
+  }
+  while (!sha.empty() && (sha.back() == '\n' || sha.back() == '\r')) sha.pop_back();
+  return sha.empty() ? std::string(HAIRBENCH_GIT_SHA) : sha;
+}
+
+std::string utc_now() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+}  // namespace
+
+double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  // Linear interpolation between closest ranks.
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+nlohmann::json context_json(const ReportContext& ctx) {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  return {{"date", utc_now()},
+          {"git_sha", git_sha()},
+          {"host", host},
+          {"cpu", cpu_name()},
+          {"hardware_threads", std::thread::hardware_concurrency()},
+          {"threads", ctx.threads},
+          {"build_type", HAIRBENCH_BUILD_TYPE},
+          {"compiler", std::string("gcc-compatible ") + __VERSION__},
+          {"devices", nlohmann::json::array()}};
+}
+
+nlohmann::json run_json(const RunRecord& r) {
+  const std::size_t done = r.step_ms.size();
+  nlohmann::json stage = nlohmann::json::object();
+  for (const auto& [name, total] : r.stage_ms_total) stage[name] = num(done ? total / static_cast<double>(done) : 0.0);
+
+  const double med = median(r.step_ms);
+  nlohmann::json timing = {
+      {"step_ms",
+       {{"mean", num(finite_mean(r.step_ms))},
+        {"median", num(med)},
+        {"min", num(r.step_ms.empty() ? NAN : *std::min_element(r.step_ms.begin(), r.step_ms.end()))},
+        {"p95", num(percentile(r.step_ms, 0.95))}}},
+      {"stage_ms", stage},
+      {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
+
+  // rest_shape_error averages the frames that end at or after settle_from.
+  std::vector<double> settled;
+  for (std::size_t f = 0; f < done; ++f)
+    if (r.t[f] >= r.settle_from - 1e-9) settled.push_back(r.rest_shape_error[f]);
+
+  nlohmann::json metrics = {
+      {"deviation_vs_reference",
+       {{"reference", r.reference},
+        {"rms", num(rms(r.deviation))},
+        {"max", num(finite_max(r.deviation))},
+        {"final", num(r.deviation.empty() ? NAN : r.deviation.back())}}},
+      {"jaggedness", {{"mean", num(finite_mean(r.jaggedness))}, {"max", num(finite_max(r.jaggedness))}}},
+      {"length_error", {{"rms", num(rms(r.length_rms))}, {"max", num(finite_max(r.length_max))}}},
+      {"rest_shape_error", num(finite_mean(settled))},
+      {"penetration", {{"max", num(finite_max(r.penetration))}}},
+      {"state_hash", metrics::hash_hex(r.state_hash)}};
+
+  nlohmann::json failure = nullptr;
+  if (r.failure) failure = {{"frame", r.failure->frame}, {"t", r.failure->t}, {"reason", r.failure->reason}};
+
+  return {{"scenario", r.scenario},
+          {"model", r.model},
+          {"backend", r.backend},
+          {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
+          {"frames", r.frames},
+          {"frames_run", done},
+          {"dt", r.dt},
+          {"settle_from", r.settle_from},
+          {"params", r.params},
+          {"status", r.failure ? "unstable" : "ok"},
+          {"failure", failure},
+          {"timing", timing},
+          {"metrics", metrics},
+          {"series",
+           {{"t", series(r.t)},
+            {"step_ms", series(r.step_ms)},
+            {"deviation_vs_reference", series(r.deviation)},
+            {"jaggedness", series(r.jaggedness)},
+            {"length_error_rms", series(r.length_rms)},
+            {"rest_shape_error", series(r.rest_shape_error)},
+            {"penetration", series(r.penetration)}}}};
+}
+
+nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs) {
+  nlohmann::json j = {{"schema", "hairbench-report"}, {"schema_version", 1}, {"context", context_json(ctx)}};
+  j["runs"] = nlohmann::json::array();
+  for (const RunRecord& r : runs) j["runs"].push_back(run_json(r));
+  return j;
+}
+
+void write_json(const std::filesystem::path& file, const nlohmann::json& j) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file);
+  out << j.dump(1) << '\n';
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+}  // namespace hairbench

@@ -1,0 +1,272 @@
+// TressFX-style follow hairs: copies of a guide hair displaced by a random offset that
+// grows towards the tip (the .tfxproj section's followHairsPerGuide, followRadius and
+// tipSeparation). The offsets live in a frame that moves with the guide, so the follow
+// hairs can be rebuilt from the simulated guides every frame.
+#include "scenarios/tfx/tfx.h"
+
+#include "core/error.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace hairbench::tfx {
+namespace {
+
+using Vec3d = Eigen::Vector3d;
+
+// splitmix64 (Steele, Lea & Flood 2014): integer-only, so the stream, and every follow
+// hair made from it, is the same on every machine and standard library.
+class Rng {
+ public:
+  explicit Rng(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  // Uniform in [-1, 1): 53 random bits, exactly representable.
+  double symmetric() { return static_cast<double>(next() >> 11) * 0x1.0p-52 - 1.0; }
+
+ private:
+  std::uint64_t state_;
+};
+
+// Uniform in the unit disk by rejection from the square: no sqrt/sin/cos whose last bit
+// could differ between C libraries.
+Eigen::Vector2d unit_disk(Rng& rng) {
+  for (;;) {
+    const double x = rng.symmetric(), y = rng.symmetric();
+    if (x * x + y * y <= 1.0) return {x, y};
+  }
+}
+
+Vec3d xyz(const Vec4f& p) { return p.head<3>().cast<double>(); }
+
+// sin of the angle between `a` and the unit vector `t` (0 when `a` is 0).
+double off_axis(const Vec3d& a, const Vec3d& t) {
+  const double n = a.norm();
+  return n > 0.0 ? a.cross(t).norm() / n : 0.0;
+}
+
+// An anchor at a smaller angle than this to the root edge orients the frame too poorly.
+constexpr double kMinAnchorSine = 0.05;
+// Any anchor at least this far off the root edge is good enough to stop looking.
+constexpr double kGoodAnchorSine = 0.5;
+
+// The point whose direction from the guide root fixes the guide's root normal. The guide
+// alone cannot fix it (a straight strand looks the same from every side), but the root of
+// another guide can: both roots are pinned to the head, so the direction between them
+// turns exactly with the head, like TressFX's per-strand root rotation, and not with the
+// guide's own swinging. The first guide after `g` (cyclically) whose root is well off g's
+// root edge is taken, else the best one; only a groom without any such guide falls back on
+// the guide's own vertex farthest off its root edge, which turns with the strand.
+std::uint32_t choose_anchor(const Groom& guides, std::size_t g) {
+  const std::uint32_t root = guides.strand_begin(g);
+  const Vec3d p0 = xyz(guides.positions[root]);
+  const Vec3d t = (xyz(guides.positions[root + 1]) - p0).normalized();
+  std::uint32_t best = root;
+  double best_sine = kMinAnchorSine;
+  const auto consider = [&](std::uint32_t candidate) {
+    const double sine = off_axis(xyz(guides.positions[candidate]) - p0, t);
+    if (sine >= best_sine) {
+      best = candidate;
+      best_sine = sine;
+    }
+    return sine >= kGoodAnchorSine;
+  };
+  const std::size_t strands = guides.strand_count();
+  for (std::size_t k = 1; k < strands; ++k)
+    if (consider(guides.strand_begin((g + k) % strands))) return best;
+  if (best != root) return best;
+  for (std::uint32_t i = 2; i < guides.strand_size(g); ++i) consider(root + i);
+  if (best == root)
+    throw InputError("follow hairs", "guide strand " + std::to_string(g),
+                     "nothing orients its follow hairs: the strand is straight and no other "
+                     "guide root lies off its root edge");
+  return best;
+}
+
+Vec3d any_perpendicular(const Vec3d& t) {
+  const Vec3d axis = std::abs(t.x()) < 0.5 ? Vec3d::UnitX() : Vec3d::UnitY();
+  return t.cross(axis).normalized();
+}
+
+// `v` with its component along unit `t` removed, normalised; any perpendicular of `t`
+// where nothing is left of `v`.
+Vec3d perpendicular_part(const Vec3d& v, const Vec3d& t) {
+  const Vec3d p = v - v.dot(t) * t;
+  const double n = p.norm();
+  return n > 1e-12 * (1.0 + v.norm()) ? Vec3d(p / n) : any_perpendicular(t);
+}
+
+// Discrete parallel transport (Bergou et al. 2008, as for jaggedness in DESIGN.md): `v`
+// turned by the rotation about t0 x t1 that takes unit t0 onto unit t1 (Rodrigues'
+// formula with the cross product unnormalised). (Anti)parallel tangents leave v as it is.
+Vec3d transport(const Vec3d& v, const Vec3d& t0, const Vec3d& t1) {
+  const Vec3d c = t0.cross(t1);
+  const double s2 = c.squaredNorm();
+  if (s2 < 1e-24) return v;
+  const double cos = t0.dot(t1);
+  // (1 - cos) / sin^2 = 1 / (1 + cos): the second form has no cancellation near cos = 1,
+  // the first none near cos = -1.
+  const double k = cos >= 0.0 ? 1.0 / (1.0 + cos) : (1.0 - cos) / s2;
+  return v * cos + c.cross(v) + c * (c.dot(v) * k);
+}
+
+struct Frame {
+  Vec3d t, n, b;
+};
+
+// The guide's frame at every vertex: the tangent along the edge to the next vertex (the
+// last vertex keeps its incoming edge; a collapsed edge of a moving guide keeps the
+// previous tangent), the normal at the root from the anchor, parallel-transported to the
+// tip, and the binormal t x n.
+void guide_frames(std::span<const Vec4f> strand, const Vec3d& anchor, std::vector<Frame>& out) {
+  const std::size_t n = strand.size();
+  out.resize(n);
+  Vec3d tangent = Vec3d::UnitY();  // kept only if the root edge itself has collapsed
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3d edge = i + 1 < n ? Vec3d(xyz(strand[i + 1]) - xyz(strand[i])) : Vec3d::Zero();
+    const double len = edge.norm();
+    if (len > 0.0) tangent = edge / len;
+    out[i].t = tangent;
+  }
+  out[0].n = perpendicular_part(anchor - xyz(strand[0]), out[0].t);
+  for (std::size_t i = 1; i < n; ++i)
+    out[i].n = perpendicular_part(transport(out[i - 1].n, out[i - 1].t, out[i].t), out[i].t);
+  for (Frame& f : out) f.b = f.t.cross(f.n);
+}
+
+void check_arguments(int per_guide, double radius, double tip_separation) {
+  if (per_guide < 0) throw std::invalid_argument("follow hairs: negative count per guide");
+  if (!std::isfinite(radius) || radius < 0.0)
+    throw std::invalid_argument("follow hairs: radius must be finite and >= 0");
+  if (!std::isfinite(tip_separation) || tip_separation < 0.0)
+    throw std::invalid_argument("follow hairs: tip separation must be finite and >= 0");
+  // The largest offset, at the tip, is stored as float.
+  if (radius * (1.0 + tip_separation) > std::numeric_limits<float>::max())
+    throw std::invalid_argument("follow hairs: offsets beyond float range");
+}
+
+// Follow strands and their vertices are indexed with 32 bits, like the groom's.
+void check_capacity(const FollowHairs& out, const Groom& guides, std::size_t first,
+                    std::size_t last, int per_guide) {
+  const std::uint64_t added =
+      std::uint64_t{guides.strand_offsets[last] - guides.strand_offsets[first]} *
+      static_cast<std::uint64_t>(per_guide);
+  if (out.vertex_count() + guides.vertex_count() + added >
+      std::numeric_limits<std::uint32_t>::max())
+    throw InputError("follow hairs", "count",
+                     "guides and follow hairs together exceed 2^32 vertices");
+}
+
+// Checks everything apply_follow_hairs indexes with, so that a FollowHairs assembled by
+// hand cannot make it read or write out of bounds.
+void check_layout(const FollowHairs& f, std::size_t guide_vertices, std::size_t out_vertices) {
+  const auto fail = [](const char* what) {
+    throw std::invalid_argument(std::string("apply_follow_hairs: ") + what);
+  };
+  if (f.guide_offsets.empty() || f.guide_offsets.back() != guide_vertices)
+    fail("guide positions do not match the guide layout");
+  if (f.vertex_count() != out_vertices) fail("output size differs from the follow vertex count");
+  if (f.anchor.size() != f.guide.size() || f.follow_offsets.size() != f.guide.size() + 1 ||
+      f.follow_offsets.back() != f.vertex_count())
+    fail("inconsistent follow strand arrays");
+  for (std::size_t g = 1; g < f.guide_offsets.size(); ++g)
+    if (f.guide_offsets[g] < f.guide_offsets[g - 1]) fail("guide offsets decrease");
+  const std::size_t guides = f.guide_offsets.size() - 1;
+  for (std::size_t s = 0; s < f.strand_count(); ++s) {
+    if (f.guide[s] >= guides || f.anchor[s] >= guide_vertices) fail("guide or anchor out of range");
+    const std::uint32_t n = f.guide_offsets[f.guide[s] + 1] - f.guide_offsets[f.guide[s]];
+    if (f.follow_offsets[s] > f.follow_offsets[s + 1] ||
+        f.follow_offsets[s + 1] - f.follow_offsets[s] != n)
+      fail("a follow strand's vertex count differs from its guide's");
+  }
+}
+
+}  // namespace
+
+void append_follow_hairs(FollowHairs& out, const Groom& guides, std::size_t first, std::size_t last,
+                         int per_guide, double radius, double tip_separation, std::uint64_t seed) {
+  check_arguments(per_guide, radius, tip_separation);
+  if (out.guide_offsets != guides.strand_offsets)
+    throw std::invalid_argument("append_follow_hairs: FollowHairs made for another guide layout");
+  if (first > last || last > guides.strand_count())
+    throw std::invalid_argument("append_follow_hairs: strand range out of bounds");
+  validate_groom(guides, "follow hair guides");
+  check_capacity(out, guides, first, last, per_guide);
+  if (per_guide == 0) return;
+  Rng rng(seed);
+  for (std::size_t g = first; g < last; ++g) {
+    const std::uint32_t anchor = choose_anchor(guides, g);
+    const std::uint32_t n = guides.strand_size(g);
+    for (int k = 0; k < per_guide; ++k) {
+      // The root offset, in the (normal, binormal) plane, i.e. perpendicular to the root
+      // edge; each vertex keeps it in its own frame, grown by the tip separation.
+      const Eigen::Vector2d d = radius * unit_disk(rng);
+      out.guide.push_back(static_cast<std::uint32_t>(g));
+      out.anchor.push_back(anchor);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const double grow =
+            1.0 + tip_separation * static_cast<double>(i) / static_cast<double>(n - 1);
+        out.offsets.emplace_back(0.0f, static_cast<float>(grow * d.x()),
+                                 static_cast<float>(grow * d.y()));
+      }
+      out.follow_offsets.push_back(static_cast<std::uint32_t>(out.offsets.size()));
+    }
+  }
+}
+
+FollowHairs make_follow_hairs(const Groom& guides, int per_guide, double radius,
+                              double tip_separation, std::uint64_t seed) {
+  FollowHairs out;
+  out.guide_offsets = guides.strand_offsets;
+  append_follow_hairs(out, guides, 0, guides.strand_count(), per_guide, radius, tip_separation,
+                      seed);
+  return out;
+}
+
+void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
+                        std::span<Vec4f> out_follow_positions) {
+  check_layout(follow, guide_positions.size(), out_follow_positions.size());
+  std::vector<Frame> frames;
+  // Follow hairs of one guide are consecutive: their guide's frames are built once.
+  std::size_t framed_guide = std::numeric_limits<std::size_t>::max(), framed_anchor = 0;
+  for (std::size_t s = 0; s < follow.strand_count(); ++s) {
+    const std::uint32_t g = follow.guide[s];
+    const std::uint32_t b = follow.guide_offsets[g];
+    const std::uint32_t n = follow.guide_offsets[g + 1] - b;
+    const std::span<const Vec4f> guide = guide_positions.subspan(b, n);
+    if (g != framed_guide || follow.anchor[s] != framed_anchor) {
+      guide_frames(guide, xyz(guide_positions[follow.anchor[s]]), frames);
+      framed_guide = g;
+      framed_anchor = follow.anchor[s];
+    }
+    const std::uint32_t o = follow.follow_offsets[s];
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const Frame& f = frames[i];
+      const Vec3d d = follow.offsets[o + i].cast<double>();
+      const Vec3d p = xyz(guide[i]) + d.x() * f.t + d.y() * f.n + d.z() * f.b;
+      out_follow_positions[o + i] = Vec4f(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                          static_cast<float>(p.z()), i < 2 ? 0.0f : guide[i].w());
+    }
+  }
+}
+
+Groom expand_follow_hairs(const Groom& guides, const FollowHairs& follow) {
+  if (follow.guide_offsets != guides.strand_offsets)
+    throw std::invalid_argument("expand_follow_hairs: FollowHairs made for another guide layout");
+  Groom out = guides;
+  const std::size_t base = guides.vertex_count();
+  out.positions.resize(base + follow.vertex_count());
+  apply_follow_hairs(follow, guides.positions, std::span<Vec4f>(out.positions).subspan(base));
+  for (std::size_t s = 0; s < follow.strand_count(); ++s) {
+    out.strand_offsets.push_back(static_cast<std::uint32_t>(base + follow.follow_offsets[s + 1]));
+    out.strand_region.push_back(guides.strand_region[follow.guide[s]]);
+  }
+  return out;
+}
+
+}  // namespace hairbench::tfx

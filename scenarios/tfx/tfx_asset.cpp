@@ -1,0 +1,120 @@
+// TressFX files -> a hairbench groom in metres with regions, parameters, colliders and
+// follow hairs.
+#include "scenarios/tfx/tfx.h"
+
+#include "core/error.h"
+
+#include <cmath>
+#include <limits>
+
+namespace hairbench::tfx {
+namespace {
+
+void check_scale(const std::filesystem::path& file, float metres_per_unit) {
+  if (!std::isfinite(metres_per_unit) || !(metres_per_unit > 0.0f))
+    throw InputError(file.string(), "metres_per_unit",
+                     std::to_string(metres_per_unit) + " is not a positive finite scale");
+}
+
+// Appends the strands of one .tfx file to `groom`, positions scaled to metres (w, the
+// inverse mass, is unit-free), all in region `region`.
+void append_strands(Groom& groom, const TfxStrands& strands, float metres_per_unit,
+                    std::uint16_t region, const std::string& source) {
+  if (groom.positions.size() + strands.positions.size() > std::numeric_limits<std::uint32_t>::max())
+    throw InputError(source, "sections", "more than 2^32 vertices in all");
+  for (const Vec4f& p : strands.positions)
+    groom.positions.emplace_back(p.x() * metres_per_unit, p.y() * metres_per_unit,
+                                 p.z() * metres_per_unit, p.w());
+  const std::uint32_t n = strands.vertices_per_strand;
+  for (std::uint32_t s = 0; s < strands.strand_count; ++s) {
+    groom.strand_offsets.push_back(groom.strand_offsets.back() + n);
+    groom.strand_region.push_back(region);
+  }
+}
+
+// Independent follow-hair streams per section: the murmur3 64-bit finaliser of seed and
+// index (splitmix64 streams from seeds one gamma apart would be shifted copies).
+std::uint64_t section_seed(std::uint64_t seed, std::size_t section) {
+  std::uint64_t h = seed ^ (0x9e3779b97f4a7c15ull * (section + 1));
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdull;
+  h ^= h >> 33;
+  h *= 0xc4ceb9fe1a85ec53ull;
+  return h ^ (h >> 33);
+}
+
+Sphere to_metres(const Sphere& s, float metres_per_unit, const std::string& source) {
+  Sphere out = s;
+  out.center *= metres_per_unit;
+  out.radius *= metres_per_unit;
+  if (!out.center.allFinite() || !std::isfinite(out.radius))
+    throw InputError(source, "collision_sphere", "out of float range in metres");
+  return out;
+}
+
+}  // namespace
+
+TfxAsset load_tfx_asset(const std::filesystem::path& file, float metres_per_unit) {
+  check_scale(file, metres_per_unit);
+  const TfxStrands strands = read_tfx(file);
+  TfxAsset asset;
+  asset.groom.region_names = {file.stem().string()};
+  append_strands(asset.groom, strands, metres_per_unit, 0, file.string());
+  asset.region_params.resize(1);
+  validate_groom(asset.groom, file.string());
+  return asset;
+}
+
+TfxAsset load_tfx_project(const std::filesystem::path& file, float metres_per_unit,
+                          std::uint64_t seed) {
+  check_scale(file, metres_per_unit);
+  const TfxProject project = read_tfxproj(file);
+  const std::filesystem::path dir = file.parent_path();
+  const std::string source = file.string();
+  if (project.sections.size() > std::numeric_limits<std::uint16_t>::max() + std::size_t{1})
+    throw InputError(source, "sections", "more sections than 16-bit region indices hold");
+
+  TfxAsset asset;
+  Groom guides;
+  guides.region_names.clear();
+  std::vector<std::size_t> first_strand;
+  for (std::size_t i = 0; i < project.sections.size(); ++i) {
+    const TfxProject::Section& section = project.sections[i];
+    const TfxStrands strands = read_tfx(dir / section.tfx_file);
+    // A section's .tfxsim overrides the project-level values (TressFX reads the project
+    // iteration counts as defaults).
+    std::map<std::string, double> params = project.params;
+    for (const auto& [key, value] : read_tfxsim(dir / section.sim_file).params) params[key] = value;
+    first_strand.push_back(guides.strand_count());
+    append_strands(guides, strands, metres_per_unit, static_cast<std::uint16_t>(i), source);
+    guides.region_names.push_back(section.name);
+    asset.region_params.push_back(std::move(params));
+  }
+  first_strand.push_back(guides.strand_count());
+  validate_groom(guides, source);
+
+  FollowHairs follow;
+  follow.guide_offsets = guides.strand_offsets;
+  for (std::size_t i = 0; i < project.sections.size(); ++i) {
+    const TfxProject::Section& section = project.sections[i];
+    try {
+      append_follow_hairs(follow, guides, first_strand[i], first_strand[i + 1],
+                          section.follow_per_guide, section.follow_radius * metres_per_unit,
+                          section.tip_separation, section_seed(seed, i));
+    } catch (const InputError& e) {
+      throw InputError(source + ": section " + section.name + ": " + e.what());
+    }
+  }
+  if (follow.empty()) {
+    asset.groom = std::move(guides);
+  } else {
+    asset.groom = expand_follow_hairs(guides, follow);
+    asset.follow = std::move(follow);
+  }
+  for (const Sphere& s : project.spheres)
+    asset.colliders.push_back(to_metres(s, metres_per_unit, source));
+  validate_groom(asset.groom, source);
+  return asset;
+}
+
+}  // namespace hairbench::tfx

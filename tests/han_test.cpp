@@ -1,0 +1,143 @@
+// Properties Han & Harada 2012 claims for methods 1-3, checked on the built-in scenarios.
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hairbench {
+namespace {
+
+using test::builtin;
+using test::kHan;
+
+// Gravity off and the head still: nothing may move (the rest shape is the goal of every
+// constraint, so any motion is a solver error).
+TEST(HanMethods, NoSpuriousMotionAtRest) {
+  Scenario sc = builtin("idle");
+  sc.gravity = Vec3f::Zero();
+  const auto runs = test::run(sc, kHan, {}, 2, 120);
+  for (const RunRecord& r : runs) {
+    ASSERT_FALSE(r.failure) << r.model;
+    EXPECT_LT(test::max_of(r.rest_shape_error), 1e-5) << r.model;
+  }
+}
+
+// Shape memory: the head jumps to a new pose and holds it; with gravity off every
+// method must bring the hair back to the head-transformed rest shape. The global
+// constraint is switched off so that the local constraints (Eq. 3-4) alone restore it.
+TEST(HanMethods, ReturnToRestShapeAfterRigidJump) {
+  Scenario sc = builtin("idle");
+  sc.gravity = Vec3f::Zero();
+  sc.head.oscillators.clear();
+  HeadKey a, b;
+  a.t = 0.0;
+  b.t = 0.1;  // a fast move to the new pose, then the head holds it
+  b.linear = true;
+  b.translate = Vec3f(0.05f, 0.03f, -0.08f);
+  b.axis = Vec3f(1.0f, 1.0f, 0.0f).normalized();
+  b.angle = 40.0 * M_PI / 180.0;
+  sc.head.keys = {a, b};
+  const auto runs = test::run(sc, kHan, {{"*", "global_stiffness", 0.0}}, 2, 240);
+  for (const RunRecord& r : runs) {
+    ASSERT_FALSE(r.failure) << r.model;
+    EXPECT_GT(test::max_of(r.rest_shape_error), 0.05) << r.model << ": the jump should disturb the hair";
+    EXPECT_LT(r.rest_shape_error.back(), 1e-3) << r.model;
+  }
+}
+
+// §3.3: with global and local constraints "there is no visual perturbation when
+// simulation starts". Paper-like parameters (TressFX ponytail sample values), gravity
+// on, head still: method 1 stays within 2% of L-bar of the rest shape for a second.
+// "Paper-like" here is the default setting (models/han/settings.h explains why the
+// TressFX values cannot hold a strand under metric gravity).
+TEST(HanMethods, QuietStart) {
+  Scenario sc = builtin("idle");
+  const auto runs = test::run(sc, {"han_m1"}, {}, 2, 60);
+  const RunRecord& r = test::find(runs, "han_m1");
+  EXPECT_LT(test::max_of(r.rest_shape_error), 0.02);
+}
+
+// §6: "Method 2 can be as smooth as method 1 if a high number of iterations is used":
+// its deviation from method 1 on `shake` shrinks as both get more local iterations.
+// Known difference: the deviation once the head has stopped (the last frame) falls at
+// every step 1 -> 2 -> 4 -> 8 -> 16, but the RMS over the whole run, dominated by the
+// 2 Hz shake itself, does not fall before 8 iterations (0.033, 0.036, 0.038, 0.033,
+// 0.022 in the paper setting): the two solvers' unconverged Gauss-Seidel and Jacobi
+// paths differ most while the motion is violent. The test asserts what holds: the
+// settled deviation at each step and the RMS from 1 to 16.
+TEST(HanMethods, Method2ConvergesToMethod1WithIterations) {
+  const Scenario sc = builtin("shake");
+  double last_final = INFINITY, first_rms = 0.0, rms = 0.0;
+  for (int it : {1, 2, 4, 8, 16}) {
+    auto setting = test::paper_setting();
+    setting.push_back({"*", "local_iterations", double(it)});
+    const auto runs = test::run(sc, {"han_m1", "han_m2"}, setting);
+    const RunRecord& m2 = test::find(runs, "han_m2");
+    EXPECT_LT(m2.deviation.back(), last_final) << "local_iterations " << it;
+    last_final = m2.deviation.back();
+    rms = test::rms_of(m2.deviation);
+    if (it == 1) first_rms = rms;
+  }
+  EXPECT_LT(rms, 0.8 * first_rms);
+}
+
+// §6: "method 1 shows the smoothest simulation result ... Method 3 shows some jagged
+// strands": jaggedness ordering with Table 2's iteration counts (2 length, 3 local).
+TEST(HanMethods, JaggednessOrderingOnShake) {
+  const auto runs = test::run(builtin("shake"), kHan, test::paper_setting());
+  const double j1 = test::mean_of(test::find(runs, "han_m1").jaggedness);
+  const double j2 = test::mean_of(test::find(runs, "han_m2").jaggedness);
+  const double j3 = test::mean_of(test::find(runs, "han_m3").jaggedness);
+  EXPECT_LE(j1, j2);
+  EXPECT_LE(j2, j3);
+}
+
+// §3.3: "If S_G is 0, there is no effect; if it is 1, the hair becomes completely
+// rigid, frozen to the initial shape."
+TEST(HanMethods, GlobalStiffnessOneFreezesZeroFrees) {
+  const Scenario sc = builtin("shake");
+  const auto frozen = test::run(sc, kHan, {{"*", "global_stiffness", 1.0}, {"*", "global_range", 1.0}, {"*", "global_ramp", 0}});
+  // Method 2's local pass still reads frames one iteration old, so after the global
+  // pass has frozen the hair it nudges it by up to ~2e-4 L-bar; "frozen" is 1e-3 here.
+  for (const RunRecord& r : frozen) EXPECT_LT(test::max_of(r.rest_shape_error), 1e-3) << r.model;
+  const auto free = test::run(sc, kHan, {{"*", "global_stiffness", 0.0}, {"*", "local_stiffness", 0.0}});
+  for (const RunRecord& r : free) EXPECT_GT(test::max_of(r.rest_shape_error), 0.1) << r.model;
+}
+
+// Edge length constraints keep strands inextensible (< 1% RMS) and collision handling
+// leaves no vertex inside a collider after any step (§3.5).
+TEST(HanMethods, LengthErrorAndNoPenetration) {
+  for (const char* name : {"idle", "nod", "shake", "walk"}) {
+    const auto runs = test::run(builtin(name), kHan);
+    for (const RunRecord& r : runs) {
+      ASSERT_FALSE(r.failure) << name << " " << r.model;
+      EXPECT_LT(test::rms_of(r.length_rms), 0.01) << name << " " << r.model;
+      EXPECT_LT(test::max_of(r.penetration), 1e-5) << name << " " << r.model;
+    }
+  }
+}
+
+// Same input -> bit-identical state, whatever the thread count.
+TEST(HanMethods, DeterministicAcrossRunsAndThreads) {
+  const Scenario sc = builtin("shake");
+  const auto a = test::run(sc, kHan, {}, 2, 90);
+  const auto b = test::run(sc, kHan, {}, 2, 90);
+  const auto c = test::run(sc, kHan, {}, 1, 90);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].state_hash, b[i].state_hash) << a[i].model;
+    EXPECT_EQ(a[i].state_hash, c[i].state_hash) << a[i].model;
+  }
+}
+
+// Every shipped scenario runs every method without instability.
+TEST(HanMethods, StableOnEveryBuiltinScenario) {
+  for (const auto& file : builtin_scenarios()) {
+    const auto runs = test::run(builtin(file.stem().string()), kHan);
+    for (const RunRecord& r : runs)
+      EXPECT_FALSE(r.failure) << file << " " << r.model << ": " << (r.failure ? r.failure->reason : "");
+  }
+}
+
+}  // namespace
+}  // namespace hairbench

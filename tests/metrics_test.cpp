@@ -1,0 +1,170 @@
+// The metric definitions of DESIGN.md and the properties each must have.
+#include "core/parallel.h"
+#include "models/registry.h"
+#include "reports/metrics.h"
+#include "reports/report.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hairbench {
+namespace {
+
+// A gently bent strand in the xy plane: a quarter circle arc of radius 0.2.
+Groom bent_groom(int strands = 3, int n = 12) {
+  Groom g;
+  for (int s = 0; s < strands; ++s) {
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < n; ++i) {
+      const float a = 0.5f * float(M_PI) * float(i) / float(n - 1);
+      pts.emplace_back(0.2f * std::sin(a) + 0.05f * float(s), 0.2f * std::cos(a), 0.01f * float(s));
+    }
+    g.add_strand(pts, 0);
+  }
+  return g;
+}
+
+std::vector<Vec4f> transformed(const std::vector<Vec4f>& p, const Affine3f& t) {
+  std::vector<Vec4f> out = p;
+  for (Vec4f& v : out) v.head<3>() = t * Vec3f(v.head<3>());
+  return out;
+}
+
+TEST(Jaggedness, ZeroOnRestShape) {
+  const Groom g = bent_groom();
+  const metrics::RestInfo rest(g);
+  EXPECT_EQ(metrics::jaggedness(rest, g.positions), 0.0);
+}
+
+TEST(Jaggedness, UnchangedByRigidMotion) {
+  const Groom g = bent_groom();
+  const metrics::RestInfo rest(g);
+  // Deform, then move the deformed groom rigidly: the metric must not change.
+  std::vector<Vec4f> p = g.positions;
+  p[5].x() += 0.01f;
+  p[17].z() -= 0.007f;
+  Affine3f t = Affine3f::Identity();
+  t.rotate(Eigen::AngleAxisf(1.1f, Vec3f(0.3f, 1.0f, -0.2f).normalized()));
+  t.pretranslate(Vec3f(0.4f, -1.0f, 2.0f));
+  const double before = metrics::jaggedness(rest, p);
+  const double after = metrics::jaggedness(rest, transformed(p, t));
+  EXPECT_GT(before, 0.0);
+  EXPECT_NEAR(before, after, 1e-4 * before);
+}
+
+// A one-vertex zig-zag is jaggier than a smooth bend with the same largest
+// displacement: the metric reads changes of curvature, not curvature.
+TEST(Jaggedness, ZigZagBeatsSmoothBend) {
+  const int n = 16;
+  Groom g;
+  std::vector<Vec3f> straight;
+  for (int i = 0; i < n; ++i) straight.emplace_back(0.0f, -0.02f * float(i), 0.0f);
+  g.add_strand(straight, 0);
+  const metrics::RestInfo rest(g);
+  const float amp = 0.01f;
+  std::vector<Vec4f> zig = g.positions, smooth = g.positions;
+  zig[8].x() += amp;
+  for (int i = 2; i < n; ++i) smooth[i].x() += amp * std::sin(float(M_PI) * float(i - 2) / float(2 * (n - 3))) ;
+  // Same maximum displacement for both shapes.
+  float smooth_max = 0.0f;
+  for (int i = 0; i < n; ++i) smooth_max = std::max(smooth_max, smooth[i].x());
+  for (int i = 0; i < n; ++i) smooth[i].x() *= amp / smooth_max;
+  EXPECT_GT(metrics::jaggedness(rest, zig), 3.0 * metrics::jaggedness(rest, smooth));
+}
+
+// The same model stepped twice from the same input is the same: deviation exactly 0.
+TEST(Deviation, MethodOneAgainstItselfIsExactlyZero) {
+  const Groom g = bent_groom(20, 16);
+  ThreadPool pool(2);
+  const ModelInfo* m1 = find_model("han_m1");
+  ASSERT_NE(m1, nullptr);
+  auto a = m1->make({&pool});
+  auto b = m1->make({&pool});
+  ParamSet params(m1->params, g.region_names.size());
+  a->reset(g, params);
+  b->reset(g, params);
+  StageTimes times;
+  for (int f = 0; f < 30; ++f) {
+    FrameInput in;
+    in.dt = 1.0 / 60.0;
+    in.t = (f + 1) * in.dt;
+    in.gravity = Vec3f(0.0f, -9.81f, 0.0f);
+    in.head.rotate(Eigen::AngleAxisf(0.3f * std::sin(float(in.t) * 6.0f), Vec3f::UnitY()));
+    a->step(in, times);
+    b->step(in, times);
+  }
+  const metrics::RestInfo rest(g);
+  EXPECT_EQ(metrics::deviation(a->positions(), b->positions(), rest.mean_strand_length), 0.0);
+  EXPECT_GT(metrics::rest_shape_error(rest, a->positions(), Affine3f::Identity()), 0.0);
+}
+
+TEST(LengthError, MeasuresRelativeStretch) {
+  const Groom g = bent_groom(1, 4);
+  const metrics::RestInfo rest(g);
+  std::vector<Vec4f> p = g.positions;
+  // Stretch the last edge by 10% along itself.
+  const Vec4f e = p[3] - p[2];
+  p[3] = p[2] + 1.1f * e;
+  const auto le = metrics::length_error(rest, p);
+  EXPECT_NEAR(le.max, 0.1, 1e-5);
+  EXPECT_NEAR(le.rms, 0.1 / std::sqrt(3.0), 1e-5);
+}
+
+TEST(Stability, DetectsNanStretchAndEscape) {
+  const Groom g = bent_groom(2, 6);
+  const metrics::RestInfo rest(g);
+  EXPECT_EQ(metrics::blowup_reason(rest, g.positions, Vec3f::Zero()), "");
+  std::vector<Vec4f> nan = g.positions;
+  nan[7].y() = std::nanf("");
+  EXPECT_NE(metrics::blowup_reason(rest, nan, Vec3f::Zero()).find("non-finite"), std::string::npos);
+  std::vector<Vec4f> far = g.positions;
+  for (Vec4f& v : far) v.x() += 100.0f;
+  EXPECT_NE(metrics::blowup_reason(rest, far, Vec3f::Zero()).find("farther"), std::string::npos);
+  std::vector<Vec4f> stretched = g.positions;
+  stretched[5].head<3>() += 2.0f * (stretched[5] - stretched[4]).head<3>();
+  EXPECT_NE(metrics::blowup_reason(rest, stretched, Vec3f::Zero()).find("edge length"), std::string::npos);
+}
+
+TEST(StateHash, ChangesWithOneBit) {
+  const Groom g = bent_groom();
+  std::vector<Vec4f> p = g.positions;
+  const auto h = metrics::state_hash(p);
+  p[10].x() = std::nextafter(p[10].x(), 1.0f);
+  EXPECT_NE(h, metrics::state_hash(p));
+  EXPECT_EQ(metrics::hash_hex(0x0123456789abcdefull), "0123456789abcdef");
+}
+
+TEST(Penetration, DeepestVertexInsideAnySphere) {
+  std::vector<Vec4f> p = {Vec4f(0.0f, 0.05f, 0.0f, 1.0f), Vec4f(0.0f, 0.3f, 0.0f, 1.0f)};
+  const std::vector<Vec4f> spheres = {Vec4f(0.0f, 0.0f, 0.0f, 0.1f)};
+  EXPECT_NEAR(metrics::penetration(p, spheres), 0.05, 1e-7);
+  p[0].y() = 0.2f;
+  EXPECT_EQ(metrics::penetration(p, spheres), 0.0);
+}
+
+TEST(ReportStats, MedianAndPercentile) {
+  EXPECT_DOUBLE_EQ(median({3.0, 1.0, 2.0}), 2.0);
+  EXPECT_DOUBLE_EQ(median({4.0, 1.0, 2.0, 3.0}), 2.5);
+  EXPECT_DOUBLE_EQ(percentile({0.0, 10.0}, 0.95), 9.5);
+}
+
+// NaN must never reach the JSON as a bare token.
+TEST(Report, NonFiniteValuesBecomeNull) {
+  RunRecord r;
+  r.model = "han_m1";
+  r.vertices = 10;
+  r.step_ms = {1.0};
+  r.t = {0.1};
+  r.deviation = {std::nan("")};
+  r.jaggedness = {INFINITY};
+  r.length_rms = r.length_max = r.rest_shape_error = r.penetration = {0.0};
+  const std::string text = run_json(r).dump();
+  EXPECT_EQ(text.find("NaN"), std::string::npos);
+  EXPECT_EQ(text.find("nan"), std::string::npos);
+  EXPECT_EQ(text.find("inf"), std::string::npos);
+  EXPECT_TRUE(run_json(r)["metrics"]["jaggedness"]["max"].is_null());
+}
+
+}  // namespace
+}  // namespace hairbench
