@@ -84,6 +84,13 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
   return a;
 }
 
+std::vector<Scenario> load_builtin(FILE* note) {
+  std::vector<std::string> skipped;
+  std::vector<Scenario> scenarios = load_builtin_scenarios(&skipped);
+  for (const std::string& why : skipped) std::fprintf(note, "hairbench: skipped: %s\n", why.c_str());
+  return scenarios;
+}
+
 void print_run(const nlohmann::json& r) {
   auto f = [](const nlohmann::json& v, const char* fmt) {
     char buf[32];
@@ -104,12 +111,11 @@ void print_run(const nlohmann::json& r) {
 
 int cmd_compare(const std::vector<std::string>& args) {
   CompareArgs a = parse_compare(args);
-  std::vector<std::filesystem::path> files;
-  if (a.scenarios.empty()) files = builtin_scenarios();
-  for (const std::string& s : a.scenarios) files.push_back(find_scenario(s));
-  // Load every scenario before running any, so a bad file fails fast.
+  // Load every scenario before running any, so a bad file fails fast. Built-in
+  // scenarios whose asset is missing are skipped with a message; named ones are errors.
   std::vector<Scenario> scenarios;
-  for (const auto& f : files) scenarios.push_back(load_scenario(f));
+  if (a.scenarios.empty()) scenarios = load_builtin(stderr);
+  for (const std::string& s : a.scenarios) scenarios.push_back(load_scenario(find_scenario(s)));
 
   ThreadPool pool(a.threads);
   std::vector<RunRecord> runs;
@@ -136,10 +142,8 @@ int cmd_list(const std::vector<std::string>& args) {
     return 0;
   }
   if (args[0] == "scenarios") {
-    for (const auto& f : builtin_scenarios()) {
-      const Scenario sc = load_scenario(f);
+    for (const Scenario& sc : load_builtin(stderr))
       std::printf("%-18s %s\n", sc.name.c_str(), sc.description.c_str());
-    }
     return 0;
   }
   throw InputError("arguments", "list " + args[0], "expected `list models` or `list scenarios`");

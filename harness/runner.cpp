@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "harness/follow_adapter.h"
 #include "reports/metrics.h"
 
 #include <chrono>
@@ -153,6 +154,8 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     Lane lane{info, nullptr, {}, reported};
     const ParamSet params = resolve_params(*info, sc, opt.overrides);
     lane.model = info->make(ModelContext{&pool});
+    // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
+    if (sc.follow) lane.model = std::make_unique<FollowHairsAdapter>(std::move(lane.model), sc.guides, *sc.follow);
     lane.model->reset(sc.groom, params);
     RunRecord& r = lane.record;
     r.scenario = sc.name;

@@ -1,6 +1,7 @@
 #include "scenarios/groom_gen.h"
 
 #include "core/error.h"
+#include "core/rng.h"
 
 #include <algorithm>
 #include <array>
@@ -34,26 +35,6 @@ constexpr double kFallOutward = 0.2;  // hair falls slightly away from the head,
 constexpr double kCombLength = 0.012;
 // Ponytail tail strands turn more tightly still: into the tie and down from it.
 constexpr double kTieLength = 0.005;
-
-// splitmix64 (Steele, Lea & Flood 2014): a few integer operations, identical on every
-// platform, unlike <random>'s distributions whose algorithms the standard leaves open.
-class SplitMix64 {
- public:
-  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  // Uniform in [0, 1): the top 53 bits scaled by 2^-53, exact in a double.
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
-  // Uniform in [-0.5, 0.5).
-  double centered() { return uniform() - 0.5; }
-
- private:
-  std::uint64_t state_;
-};
 
 // libm's sin and cos may differ in the last bit between library versions and between
 // the FMA and non-FMA code paths glibc picks at run time. The groom must be

@@ -438,14 +438,17 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
   // A bare .tfx file has no follow hairs: their keys would silently do nothing.
   if (!project) g.reject({"follow_hairs", "seed"}, "applies to tfx_project only (a .tfx file has no follow hairs)");
 
-  const fs::path file = (fs::path(r.file()).parent_path() / g.string(key)).lexically_normal();
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) throw MissingAssetError(r.file(), g.key(key), "no such file: " + file.string());
   // TressFX's sample assets are authored in centimetres.
   const std::string unit = g.one_of_or_first("unit", {"cm", "mm", "m"});
   const float metres_per_unit = unit == "cm" ? 0.01f : unit == "mm" ? 0.001f : 1.0f;
   const bool simulate_follow = g.one_of_or_first("follow_hairs", {"follow", "simulate"}) == "simulate";
   const std::uint64_t seed = g.has("seed") ? as_seed(r, g.at("seed"), g.key("seed")) : 1;
+  // The pivot is the head centre: the head rest frame's origin, about which it turns.
+  Vec3f pivot = g.has("pivot") ? Vec3f(g.vec3("pivot") * metres_per_unit) : Vec3f::Zero();
+
+  const fs::path file = (fs::path(r.file()).parent_path() / g.string(key)).lexically_normal();
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) throw MissingAssetError(r.file(), g.key(key), "no such file: " + file.string());
 
   tfx::TfxAsset asset;
   try {
@@ -455,15 +458,12 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
     throw InputError(r.file() + ": " + g.key(key) + ": " + e.what());
   }
 
-  // The pivot is the head centre: the head rest frame's origin, about which it turns.
-  Vec3f pivot;
-  if (g.has("pivot")) {
-    pivot = g.vec3("pivot") * metres_per_unit;
-  } else if (!asset.colliders.empty()) {
+  // Without one, a project's first collision sphere (TressFX's head sphere) is the centre.
+  if (!g.has("pivot")) {
+    if (asset.colliders.empty())
+      r.fail(g.key("pivot"), std::string("missing required key (the head centre in asset units; ") +
+                                 (project ? "the project has no collision sphere" : "a .tfx file has no head") + ")");
     pivot = asset.colliders.front().center;
-  } else {
-    r.fail(g.key("pivot"), std::string("missing required key (the head centre in asset units: ") +
-                               (project ? "the project has no collision sphere" : "a .tfx file has no head") + ")");
   }
   translate(asset.groom, -pivot);
   for (Sphere& s : asset.colliders) s.center -= pivot;

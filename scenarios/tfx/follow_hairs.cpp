@@ -5,6 +5,7 @@
 #include "scenarios/tfx/tfx.h"
 
 #include "core/error.h"
+#include "core/rng.h"
 
 #include <cmath>
 #include <limits>
@@ -15,27 +16,9 @@ namespace {
 
 using Vec3d = Eigen::Vector3d;
 
-// splitmix64 (Steele, Lea & Flood 2014): integer-only, so the stream, and every follow
-// hair made from it, is the same on every machine and standard library.
-class Rng {
- public:
-  explicit Rng(std::uint64_t seed) : state_(seed) {}
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-  }
-  // Uniform in [-1, 1): 53 random bits, exactly representable.
-  double symmetric() { return static_cast<double>(next() >> 11) * 0x1.0p-52 - 1.0; }
-
- private:
-  std::uint64_t state_;
-};
-
 // Uniform in the unit disk by rejection from the square: no sqrt/sin/cos whose last bit
 // could differ between C libraries.
-Eigen::Vector2d unit_disk(Rng& rng) {
+Eigen::Vector2d unit_disk(SplitMix64& rng) {
   for (;;) {
     const double x = rng.symmetric(), y = rng.symmetric();
     if (x * x + y * y <= 1.0) return {x, y};
@@ -198,7 +181,7 @@ void append_follow_hairs(FollowHairs& out, const Groom& guides, std::size_t firs
   validate_groom(guides, "follow hair guides");
   check_capacity(out, guides, first, last, per_guide);
   if (per_guide == 0) return;
-  Rng rng(seed);
+  SplitMix64 rng(seed);
   for (std::size_t g = first; g < last; ++g) {
     const std::uint32_t anchor = choose_anchor(guides, g);
     const std::uint32_t n = guides.strand_size(g);

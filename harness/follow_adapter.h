@@ -1,0 +1,36 @@
+// Runs a model on the guide strands of an imported groom and rebuilds the follow hairs
+// from them after every step, as TressFX does: the follow strands cost no simulation, and
+// the metrics still see the full groom.
+#pragma once
+
+#include "core/hair_model.h"
+#include "scenarios/tfx/tfx.h"
+
+#include <memory>
+#include <vector>
+
+namespace hairbench {
+
+class FollowHairsAdapter final : public HairModel {
+ public:
+  // `guides` and `follow` must outlive the adapter; `follow` is laid out on `guides`.
+  FollowHairsAdapter(std::unique_ptr<HairModel> inner, const Groom& guides, const tfx::FollowHairs& follow);
+
+  // `rest` is the full groom (guides, then follow strands); the inner model is reset
+  // with the guides only.
+  void reset(const Groom& rest, const ParamSet& params) override;
+  // Steps the inner model, then rebuilds the follow strands (stage "follow_hairs").
+  void step(const FrameInput& in, StageTimes& out_times) override;
+  // The guides' positions, then the follow strands'.
+  std::span<const Vec4f> positions() const override { return positions_; }
+
+ private:
+  void rebuild();
+
+  std::unique_ptr<HairModel> inner_;
+  const Groom& guides_;
+  const tfx::FollowHairs& follow_;
+  std::vector<Vec4f> positions_;
+};
+
+}  // namespace hairbench
