@@ -1,5 +1,6 @@
 // Scenario layer: the loader's contract (DESIGN.md "Scenario file"), the shipped
 // scenarios, the procedural grooms and the head-motion script.
+#include "scenario_support.h"
 #include "scenarios/scenario.h"
 
 #include "core/error.h"
@@ -32,14 +33,7 @@ fs::path write_temp(const std::string& name, const std::string& text) {
   return file;
 }
 
-std::string error_of(const fs::path& file) {
-  try {
-    load_scenario(file);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 // A valid scenario around a caller-supplied fragment, for loader tests.
 std::string scenario_with(const std::string& extra) {

@@ -6,6 +6,7 @@
 #include "harness/follow_adapter.h"
 #include "harness/runner.h"
 #include "models/registry.h"
+#include "scenario_support.h"
 #include "scenarios/scenario.h"
 
 #include <gtest/gtest.h>
@@ -48,14 +49,7 @@ fs::path write_scenario(const std::string& name, const std::string& groom) {
   return file;
 }
 
-std::string error_of(const fs::path& file) {
-  try {
-    load_scenario(file);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 void expect_counts(const Scenario& sc, std::size_t guides, std::size_t per_guide, std::size_t vertices) {
   EXPECT_EQ(sc.groom.strand_count(), guides * (1 + per_guide));
