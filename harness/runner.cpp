@@ -180,7 +180,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
 
   const int frames = opt.frames > 0 ? opt.frames : sc.frames;
   for (Lane& l : lanes) l.record.frames = frames;
-  const metrics::RestInfo rest(sc.groom);
+  const metrics::RestInfo rest(sc.groom, sc.follow ? sc.guides.strand_count() : sc.groom.strand_count());
   StageTimes times;
   std::vector<Vec4f> spheres;
 

@@ -12,12 +12,18 @@ namespace {
 Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
 }  // namespace
 
-RestInfo::RestInfo(const Groom& rest)
-    : groom(&rest), rest_length(rest_edge_lengths(rest)), mean_strand_length(hairbench::mean_strand_length(rest)) {
+RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
+    : groom(&rest),
+      rest_length(rest_edge_lengths(rest)),
+      mean_strand_length(hairbench::mean_strand_length(rest)),
+      head_extent(0.0),
+      simulated_strands(std::min(simulated, rest.strand_count())) {
   rest_jaggedness.resize(rest.strand_count());
-  for (std::size_t s = 0; s < rest.strand_count(); ++s)
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
     rest_jaggedness[s] = strand_jaggedness_raw(
         std::span(rest.positions).subspan(rest.strand_begin(s), rest.strand_size(s)));
+    head_extent = std::max(head_extent, xyz(rest.positions[rest.strand_begin(s)]).norm());
+  }
 }
 
 double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
@@ -94,18 +100,30 @@ double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_sphere
   return deepest;
 }
 
+// DESIGN.md's "a vertex farther than 10 L-bar from the head" reads "from the head" as from
+// the head body, which carries the roots: every root lies within head_extent of the head
+// centre, so a vertex more than head_extent + 10 L-bar from the centre is farther than
+// 10 L-bar from every point of the head. (A bare distance from the centre would call a
+// groom unstable at rest whose roots span more than 10 strand lengths: TestHair1's 11 cm
+// strands sit up to 1.06 m from its centre.)
+// The edge test covers the strands the models simulate. Follow strands rebuilt from a guide
+// are that guide plus a rigid offset (tfx::FollowHairs): their edges are not constrained
+// and change length whenever the guide turns against the offset, so their stretch is the
+// follow layer's, reported by length_error, not a blow-up of the model; NaN/Inf and the
+// distance test still cover them.
 std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center) {
   const Groom& g = *rest.groom;
-  const double far = 10.0 * rest.mean_strand_length;
+  const double far = rest.head_extent + 10.0 * rest.mean_strand_length;
   const Eigen::Vector3d c = head_center.cast<double>();
   for (std::size_t s = 0; s < g.strand_count(); ++s) {
     const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
+    const bool simulated = s < rest.simulated_strands;
     for (std::size_t i = b; i < b + n; ++i) {
       if (!p[i].allFinite())
         return "non-finite position (strand " + std::to_string(s) + ", vertex " + std::to_string(i - b) + ")";
       if ((xyz(p[i]) - c).norm() > far)
         return "vertex farther than 10 mean strand lengths from the head (strand " + std::to_string(s) + ")";
-      if (i > b) {
+      if (simulated && i > b) {
         const double e = std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
         if (e > 0.5)
           return "edge length error above 50% (strand " + std::to_string(s) + ", edge " + std::to_string(i - b) + ")";

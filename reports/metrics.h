@@ -14,11 +14,16 @@ namespace hairbench::metrics {
 
 // What the metrics need of the rest groom, computed once per run.
 struct RestInfo {
-  explicit RestInfo(const Groom& rest);
+  // `simulated_strands`: how many leading strands the models simulate; the strands after
+  // them are follow hairs rebuilt from those (a scenario's follow_hairs "follow"). All by
+  // default.
+  explicit RestInfo(const Groom& rest, std::size_t simulated_strands = SIZE_MAX);
   const Groom* groom;
   std::vector<float> rest_length;        // per edge, indexed by its second vertex
   double mean_strand_length;             // L-bar
   std::vector<double> rest_jaggedness;   // per strand, raw (not rest-subtracted)
+  double head_extent;                    // largest root distance from the head centre (rest frame origin)
+  std::size_t simulated_strands;
 };
 
 // sqrt(mean over vertices |p - p_ref|^2) / L-bar.
@@ -44,8 +49,9 @@ double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Af
 // Deepest vertex inside any sphere (xyz centre, w radius), metres; 0 if none.
 double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres);
 
-// Empty if the state is sane, else why the model is declared unstable: NaN/Inf, an edge
-// stretched or shrunk by more than 50%, or a vertex farther than 10 L-bar from the head.
+// Empty if the state is sane, else why the model is declared unstable: NaN/Inf, an edge of
+// a simulated strand stretched or shrunk by more than 50%, or a vertex farther than
+// 10 L-bar from the head (beyond the head's extent about `head_center`: see metrics.cpp).
 std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center);
 
 // 64-bit FNV-1a over the bits of every position (xyzw): bit-exact determinism checks.

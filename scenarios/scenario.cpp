@@ -443,6 +443,9 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
   const float metres_per_unit = unit == "cm" ? 0.01f : unit == "mm" ? 0.001f : 1.0f;
   const bool simulate_follow = g.one_of_or_first("follow_hairs", {"follow", "simulate"}) == "simulate";
   const std::uint64_t seed = g.has("seed") ? as_seed(r, g.at("seed"), g.key("seed")) : 1;
+  // Strands shorter than this (metres) move rigidly with the head (tfx::load_tfx_asset).
+  const double rigid_below = g.number_or("rigid_strands_below", 0.0);
+  check_range(r, g.key("rigid_strands_below"), rigid_below, 0.0, 1.0);
   // The pivot is the head centre: the head rest frame's origin, about which it turns.
   Vec3f pivot = g.has("pivot") ? Vec3f(g.vec3("pivot") * metres_per_unit) : Vec3f::Zero();
 
@@ -452,7 +455,8 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
 
   tfx::TfxAsset asset;
   try {
-    asset = project ? tfx::load_tfx_project(file, metres_per_unit, seed) : tfx::load_tfx_asset(file, metres_per_unit);
+    asset = project ? tfx::load_tfx_project(file, metres_per_unit, seed, rigid_below)
+                    : tfx::load_tfx_asset(file, metres_per_unit, rigid_below);
   } catch (const InputError& e) {
     // The asset loader names the asset file and the place; say which scenario asked.
     throw InputError(r.file() + ": " + g.key(key) + ": " + e.what());
@@ -510,7 +514,7 @@ std::vector<Sphere> read_groom(const Obj& top, Scenario& sc) {
   const std::string path = top.key("groom");
   if (as_object(r, j, path).contains("tfx") || j.contains("tfx_project")) {
     ImportedGroom imported = read_imported_groom(
-        Obj(r, j, path, {"tfx", "tfx_project", "unit", "pivot", "follow_hairs", "seed"}), sc.head_radius);
+        Obj(r, j, path, {"tfx", "tfx_project", "unit", "pivot", "follow_hairs", "seed", "rigid_strands_below"}), sc.head_radius);
     sc.groom = std::move(imported.groom);
     sc.region_params = std::move(imported.region_params);
     sc.follow = std::move(imported.follow);

@@ -126,6 +126,49 @@ TEST(Stability, DetectsNanStretchAndEscape) {
   EXPECT_NE(metrics::blowup_reason(rest, stretched, Vec3f::Zero()).find("edge length"), std::string::npos);
 }
 
+// "Farther than 10 L-bar from the head" is measured from the head body, which holds the
+// roots: a groom whose roots span many strand lengths (TestHair1: 11 cm strands up to
+// 1.06 m from its centre) is sane at rest, and a vertex is caught once it is 10 L-bar
+// beyond the farthest root's distance from the head centre.
+TEST(Stability, DistanceIsFromTheHeadNotItsCentre) {
+  Groom g;
+  const std::vector<Vec3f> near{{0.1f, 0, 0}, {0.2f, 0, 0}, {0.3f, 0, 0}};
+  const std::vector<Vec3f> far{{5.0f, 0, 0}, {5.0f, 0.1f, 0}, {5.0f, 0.2f, 0}};
+  g.add_strand(near, 0);
+  g.add_strand(far, 0);
+  const metrics::RestInfo rest(g);
+  ASSERT_NEAR(rest.mean_strand_length, 0.2, 1e-6);
+  ASSERT_NEAR(rest.head_extent, 5.0, 1e-6);
+  EXPECT_EQ(metrics::blowup_reason(rest, g.positions, Vec3f::Zero()), "");
+  // The head centre moved 1 m: everything moved with it, still sane.
+  std::vector<Vec4f> moved = g.positions;
+  for (Vec4f& v : moved) v.z() += 1.0f;
+  EXPECT_EQ(metrics::blowup_reason(rest, moved, Vec3f(0, 0, 1)), "");
+  // A strand pulled along, edges intact, 10 L-bar + 5 m out: escaped.
+  std::vector<Vec4f> escaped = g.positions;
+  for (std::size_t i = 3; i < 6; ++i) escaped[i].x() += 2.01f;
+  EXPECT_NE(metrics::blowup_reason(rest, escaped, Vec3f::Zero()).find("farther"), std::string::npos);
+  for (std::size_t i = 3; i < 6; ++i) escaped[i].x() -= 0.02f;
+  EXPECT_EQ(metrics::blowup_reason(rest, escaped, Vec3f::Zero()), "");
+}
+
+// Follow strands rebuilt from guides (those after simulated_strands) are not held to the
+// edge bound, which is the simulation's; NaN and escape still count everywhere.
+TEST(Stability, EdgeBoundCoversSimulatedStrandsOnly) {
+  const Groom g = bent_groom(3, 6);
+  const metrics::RestInfo rest(g, 2);
+  std::vector<Vec4f> stretched = g.positions;
+  stretched[17].head<3>() += 2.0f * (stretched[17] - stretched[16]).head<3>();
+  EXPECT_EQ(metrics::blowup_reason(rest, stretched, Vec3f::Zero()), "");
+  EXPECT_NE(metrics::blowup_reason(metrics::RestInfo(g), stretched, Vec3f::Zero()).find("edge length"),
+            std::string::npos);
+  stretched[5].head<3>() += 2.0f * (stretched[5] - stretched[4]).head<3>();
+  EXPECT_NE(metrics::blowup_reason(rest, stretched, Vec3f::Zero()).find("strand 0"), std::string::npos);
+  std::vector<Vec4f> nan = g.positions;
+  nan[15].x() = std::nanf("");
+  EXPECT_NE(metrics::blowup_reason(rest, nan, Vec3f::Zero()).find("non-finite"), std::string::npos);
+}
+
 TEST(StateHash, ChangesWithOneBit) {
   const Groom g = bent_groom();
   std::vector<Vec4f> p = g.positions;

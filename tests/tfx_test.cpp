@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -326,9 +327,20 @@ TEST(ShippedAssets, PonytailProjectLoadsInMetres) {
                                            {"global_stiffness", 0.1}, {"global_range", 0.3},
                                            {"length_iterations", 3},  {"local_iterations", 3}};
   EXPECT_EQ(a.region_params[3], tail);
+  // The project's three spheres (radius 26.5, 24.113, 25.5 cm) hold free rest vertices up
+  // to 9.5 cm deep: each keeps its centre and shrinks to its nearest free rest vertex.
   ASSERT_EQ(a.colliders.size(), 3u);
-  EXPECT_FLOAT_EQ(a.colliders[0].radius, 0.265f);
   EXPECT_FLOAT_EQ(a.colliders[1].center.y(), 0.93707f);
+  const float project_radius[3] = {0.265f, 0.24113f, 0.255f};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Sphere& c = a.colliders[k];
+    EXPECT_TRUE(c.head_attached);
+    float nearest = INFINITY;
+    for (const Vec4f& p : a.groom.positions)
+      if (p.w() != 0.0f) nearest = std::min(nearest, (p.head<3>() - c.center).norm());
+    EXPECT_EQ(c.radius, std::min(nearest, project_radius[k]));
+    EXPECT_LT(c.radius, project_radius[k] - 0.04f);
+  }
   // followRadius 0.4 cm: every follow root lies within 4 mm of its guide root.
   for (std::size_t f = 0; f < a.follow.strand_count(); ++f) {
     const Vec4f d = a.groom.positions[a.groom.strand_begin(guides + f)] -
@@ -350,6 +362,38 @@ TEST(ShippedAssets, TestHair1ProjectLoads) {
   EXPECT_EQ(a.region_params[0].at("length_iterations"), 3.0);
   EXPECT_EQ(a.region_params[0].at("local_iterations"), 3.0);
   EXPECT_TRUE(a.colliders.empty());
+}
+
+// The mohawk has stubble: 18 strands under 0.4 mm with 32 vertices each. With
+// rigid_below, exactly the strands shorter than it are pinned whole; the others keep the
+// file's pins (vertices 0 and 1).
+TEST(ShippedAssets, RigidBelowPinsOnlyTheShortStrands) {
+  const fs::path file = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
+  SKIP_IF_MISSING(file);
+  const TfxAsset plain = load_tfx_asset(file, 0.01f);
+  const TfxAsset rigid = load_tfx_asset(file, 0.01f, 0.005);
+  std::size_t pinned_whole = 0, short_strands = 0;
+  for (std::size_t s = 0; s < plain.groom.strand_count(); ++s) {
+    const std::uint32_t b = plain.groom.strand_begin(s), n = plain.groom.strand_size(s);
+    double length = 0.0;
+    for (std::uint32_t i = b + 1; i < b + n; ++i)
+      length += (plain.groom.positions[i] - plain.groom.positions[i - 1]).head<3>().cast<double>().norm();
+    const bool is_short = length < 0.005;
+    short_strands += is_short;
+    bool all_pinned = true;
+    for (std::uint32_t i = b; i < b + n; ++i) {
+      all_pinned &= rigid.groom.positions[i].w() == 0.0f;
+      ASSERT_EQ(rigid.groom.positions[i].head<3>(), plain.groom.positions[i].head<3>());
+      if (!is_short) {
+        ASSERT_EQ(rigid.groom.positions[i].w(), plain.groom.positions[i].w());
+      }
+    }
+    pinned_whole += all_pinned;
+    EXPECT_EQ(all_pinned, is_short) << "strand " << s;
+  }
+  EXPECT_EQ(pinned_whole, short_strands);
+  EXPECT_GE(short_strands, 18u);
+  EXPECT_LT(short_strands, 2226u / 10u);
 }
 
 TEST(ShippedAssets, SingleTfxAsset) {
@@ -556,6 +600,37 @@ TEST(FollowHairs, FollowTheGuideWhenItBends) {
     EXPECT_NEAR((out[k] - bent[k]).head<3>().norm(), d_rest, 1e-6f);
   }
   EXPECT_GT(max_distance(out, rest), 0.01);
+}
+
+// TressFX rebuilds a follow hair as its guide plus a fixed root offset grown towards the
+// tip; here the offset turns with the guide's root frame. However the free part of the
+// guide swings, every follow vertex keeps its rest offset from its guide vertex: the
+// follow hair's pinned vertices stay put, and follow edge i is guide edge i plus a fixed
+// increment (per-vertex frames would swing that by |offset| times the bend instead).
+TEST(FollowHairs, SwingingGuidesKeepEveryFollowOffset) {
+  const Groom g = bent_groom(6, 10);
+  const FollowHairs f = make_follow_hairs(g, 3, 0.02, 5.0, 17);
+  std::vector<Vec4f> swung = g.positions;
+  for (std::size_t s = 0; s < g.strand_count(); ++s)
+    for (std::uint32_t i = 2; i < 10; ++i) {
+      Vec4f& p = swung[g.strand_begin(s) + i];
+      p.x() += 0.03f * static_cast<float>(i * i) / 81.0f;
+      p.z() -= 0.05f * static_cast<float>(i) / 9.0f;
+    }
+  std::vector<Vec4f> rest(f.vertex_count()), out(f.vertex_count());
+  apply_follow_hairs(f, g.positions, rest);
+  apply_follow_hairs(f, swung, out);
+  for (std::size_t s = 0; s < f.strand_count(); ++s) {
+    const std::uint32_t gb = f.guide_offsets[f.guide[s]], fb = f.follow_offsets[s];
+    for (std::uint32_t i = 0; i < 10; ++i) {
+      const Vec3f rest_offset = (rest[fb + i] - g.positions[gb + i]).head<3>();
+      const Vec3f offset = (out[fb + i] - swung[gb + i]).head<3>();
+      EXPECT_LE((offset - rest_offset).norm(), 1e-7f);
+      if (i < 2) {
+        EXPECT_EQ(out[fb + i], rest[fb + i]);
+      }
+    }
+  }
 }
 
 TEST(FollowHairs, OneStraightGuideHasNothingToOrientIt) {

@@ -1,7 +1,7 @@
 // TressFX-style follow hairs: copies of a guide hair displaced by a random offset that
 // grows towards the tip (the .tfxproj section's followHairsPerGuide, followRadius and
-// tipSeparation). The offsets live in a frame that moves with the guide, so the follow
-// hairs can be rebuilt from the simulated guides every frame.
+// tipSeparation). The offset lives in the guide's root frame, which turns with the head,
+// so the follow hairs can be rebuilt from the simulated guides every frame.
 #include "scenarios/tfx/tfx.h"
 
 #include "core/error.h"
@@ -84,42 +84,21 @@ Vec3d perpendicular_part(const Vec3d& v, const Vec3d& t) {
   return n > 1e-12 * (1.0 + v.norm()) ? Vec3d(p / n) : any_perpendicular(t);
 }
 
-// Discrete parallel transport (Bergou et al. 2008, as for jaggedness in DESIGN.md): `v`
-// turned by the rotation about t0 x t1 that takes unit t0 onto unit t1 (Rodrigues'
-// formula with the cross product unnormalised). (Anti)parallel tangents leave v as it is.
-Vec3d transport(const Vec3d& v, const Vec3d& t0, const Vec3d& t1) {
-  const Vec3d c = t0.cross(t1);
-  const double s2 = c.squaredNorm();
-  if (s2 < 1e-24) return v;
-  const double cos = t0.dot(t1);
-  // (1 - cos) / sin^2 = 1 / (1 + cos): the second form has no cancellation near cos = 1,
-  // the first none near cos = -1.
-  const double k = cos >= 0.0 ? 1.0 / (1.0 + cos) : (1.0 - cos) / s2;
-  return v * cos + c.cross(v) + c * (c.dot(v) * k);
-}
-
 struct Frame {
   Vec3d t, n, b;
 };
 
-// The guide's frame at every vertex: the tangent along the edge to the next vertex (the
-// last vertex keeps its incoming edge; a collapsed edge of a moving guide keeps the
-// previous tangent), the normal at the root from the anchor, parallel-transported to the
-// tip, and the binormal t x n.
-void guide_frames(std::span<const Vec4f> strand, const Vec3d& anchor, std::vector<Frame>& out) {
-  const std::size_t n = strand.size();
-  out.resize(n);
-  Vec3d tangent = Vec3d::UnitY();  // kept only if the root edge itself has collapsed
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3d edge = i + 1 < n ? Vec3d(xyz(strand[i + 1]) - xyz(strand[i])) : Vec3d::Zero();
-    const double len = edge.norm();
-    if (len > 0.0) tangent = edge / len;
-    out[i].t = tangent;
-  }
-  out[0].n = perpendicular_part(anchor - xyz(strand[0]), out[0].t);
-  for (std::size_t i = 1; i < n; ++i)
-    out[i].n = perpendicular_part(transport(out[i - 1].n, out[i - 1].t, out[i].t), out[i].t);
-  for (Frame& f : out) f.b = f.t.cross(f.n);
+// The guide's root frame: the tangent along the root edge, the normal towards the anchor
+// (perpendicular to the tangent) and the binormal t x n. Root and anchor are pinned, so
+// the frame turns exactly with the head. (A zero root edge cannot reach here: grooms are
+// validated and the root edge is pinned.)
+Frame root_frame(std::span<const Vec4f> strand, const Vec3d& anchor) {
+  Frame f;
+  const Vec3d edge = xyz(strand[1]) - xyz(strand[0]);
+  f.t = edge.normalized();
+  f.n = perpendicular_part(anchor - xyz(strand[0]), f.t);
+  f.b = f.t.cross(f.n);
+  return f;
 }
 
 void check_arguments(int per_guide, double radius, double tip_separation) {
@@ -187,7 +166,7 @@ void append_follow_hairs(FollowHairs& out, const Groom& guides, std::size_t firs
     const std::uint32_t n = guides.strand_size(g);
     for (int k = 0; k < per_guide; ++k) {
       // The root offset, in the (normal, binormal) plane, i.e. perpendicular to the root
-      // edge; each vertex keeps it in its own frame, grown by the tip separation.
+      // edge; vertex i keeps it, grown by the tip separation, in the guide's root frame.
       const Eigen::Vector2d d = radius * unit_disk(rng);
       out.guide.push_back(static_cast<std::uint32_t>(g));
       out.anchor.push_back(anchor);
@@ -214,22 +193,14 @@ FollowHairs make_follow_hairs(const Groom& guides, int per_guide, double radius,
 void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
                         std::span<Vec4f> out_follow_positions) {
   check_layout(follow, guide_positions.size(), out_follow_positions.size());
-  std::vector<Frame> frames;
-  // Follow hairs of one guide are consecutive: their guide's frames are built once.
-  std::size_t framed_guide = std::numeric_limits<std::size_t>::max(), framed_anchor = 0;
   for (std::size_t s = 0; s < follow.strand_count(); ++s) {
     const std::uint32_t g = follow.guide[s];
     const std::uint32_t b = follow.guide_offsets[g];
     const std::uint32_t n = follow.guide_offsets[g + 1] - b;
     const std::span<const Vec4f> guide = guide_positions.subspan(b, n);
-    if (g != framed_guide || follow.anchor[s] != framed_anchor) {
-      guide_frames(guide, xyz(guide_positions[follow.anchor[s]]), frames);
-      framed_guide = g;
-      framed_anchor = follow.anchor[s];
-    }
+    const Frame f = root_frame(guide, xyz(guide_positions[follow.anchor[s]]));
     const std::uint32_t o = follow.follow_offsets[s];
     for (std::uint32_t i = 0; i < n; ++i) {
-      const Frame& f = frames[i];
       const Vec3d d = follow.offsets[o + i].cast<double>();
       const Vec3d p = xyz(guide[i]) + d.x() * f.t + d.y() * f.n + d.z() * f.b;
       out_follow_positions[o + i] = Vec4f(static_cast<float>(p.x()), static_cast<float>(p.y()),

@@ -86,9 +86,16 @@ TfxProject read_tfxproj(const std::filesystem::path& file);
 // ---- follow hairs ---------------------------------------------------------------------
 
 // TressFX renders several "follow" hairs around each simulated guide hair: a follow hair
-// is its guide displaced by a fixed offset that grows towards the tip. Here the offset of
-// every follow vertex is kept in the frame of the guide at the same vertex (tangent,
-// parallel-transported normal, binormal), so follow hairs bend and turn with their guide.
+// is its guide displaced by a fixed root offset that grows towards the tip (TressFX's
+// UpdateFollowHairVertices: guide vertex + (1 + tipSeparation * i/n) * rootOffset). Here
+// the offset is kept in the guide's root frame (root tangent, a normal fixed by a pinned
+// anchor, binormal), so it turns with the head; a follow vertex moves exactly as its guide
+// vertex plus that rigid offset, so the follow strand's pinned vertices move rigidly with
+// the head like its guide's (whenever the anchor is another guide's root: see
+// make_follow_hairs).
+// (Offsets carried in per-vertex frames instead would swing by |offset| times the bend:
+// with TressFX's tip separations that stretches follow edges many times faster than the
+// guide bends.)
 struct FollowHairs {
   // Strand layout of the guide positions this applies to (the guide groom's
   // strand_offsets).
@@ -99,7 +106,7 @@ struct FollowHairs {
   std::vector<std::uint32_t> anchor;
   // Follow strand f owns offsets [follow_offsets[f], follow_offsets[f+1]); it has as many
   // vertices as its guide. Each offset is (tangent, normal, binormal) components in the
-  // guide's frame at the same vertex index.
+  // guide's root frame, already grown for its vertex.
   std::vector<std::uint32_t> follow_offsets{0};
   std::vector<Vec3f> offsets;
 
@@ -128,8 +135,8 @@ void append_follow_hairs(FollowHairs& out, const Groom& guides, std::size_t firs
 // guide's region and vertices 0 and 1 pinned.
 Groom expand_follow_hairs(const Groom& guides, const FollowHairs& follow);
 
-// Rebuilds the follow strands from the current guide positions (the frames are recomputed
-// from them on every call). out_follow_positions gets follow.vertex_count() vertices;
+// Rebuilds the follow strands from the current guide positions (the root frames are
+// recomputed from them on every call). out_follow_positions gets follow.vertex_count() vertices;
 // w is the guide vertex's w, with vertices 0 and 1 pinned. Throws std::invalid_argument
 // when a span does not match `follow`'s layout.
 void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
@@ -142,18 +149,24 @@ struct TfxAsset {
   // `follow` is not empty, its strands follow in FollowHairs order.
   Groom groom;
   std::vector<std::map<std::string, double>> region_params;  // one per groom region
-  std::vector<Sphere> colliders;                             // metres, head-attached
+  std::vector<Sphere> colliders;                             // metres, head-attached, fitted to the rest hair
   FollowHairs follow;                                        // empty when there are no follow hairs
 };
 
 // One .tfx file: one region named after the file stem, no parameters, no colliders.
-TfxAsset load_tfx_asset(const std::filesystem::path& file, float metres_per_unit);
+// Strands shorter than `rigid_below` metres get every vertex pinned (0: none; see
+// pin_short_strands in tfx_asset.cpp for why).
+TfxAsset load_tfx_asset(const std::filesystem::path& file, float metres_per_unit,
+                        double rigid_below = 0.0);
 
 // A .tfxproj with its .tfx and .tfxsim files (paths relative to the project): one region
 // per section, named by the section, with the project's parameters overridden by the
 // section's .tfxsim; collision spheres as colliders; follow hairs per section (radius
-// scaled to metres), seeded from `seed` and the section index.
+// scaled to metres), seeded from `seed` and the section index. Each collision sphere keeps
+// its centre and shrinks, where needed, until no free rest vertex (follow hairs included)
+// lies inside it: TressFX's spheres overlap the hair they stand for the head under.
+// Guides shorter than `rigid_below` metres, and their follow hairs, are pinned whole.
 TfxAsset load_tfx_project(const std::filesystem::path& file, float metres_per_unit,
-                          std::uint64_t seed);
+                          std::uint64_t seed, double rigid_below = 0.0);
 
 }  // namespace hairbench::tfx
