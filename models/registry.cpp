@@ -2,6 +2,12 @@
 
 #include "models/han/model.h"
 #include "models/han/settings.h"
+#include "models/halen_cascade/model.h"
+#include "models/halen_cascade/settings.h"
+#include "models/halen_forest/model.h"
+#include "models/halen_forest/settings.h"
+#include "models/halen_spring/model.h"
+#include "models/halen_spring/settings.h"
 
 #include <vector>
 
@@ -15,6 +21,12 @@ std::span<const ModelInfo> model_registry() {
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Jacobi, c); }},
       {"han_m3", "Han & Harada 2012 method 3: rest-state transforms (Algorithm 5)",
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::RestFrames, c); }},
+      {"halen_spring", "Halén & Wester 2007 §4.4: springs to head-fixed reference nodes, tilt-weakened (§5.9)",
+       halen_spring::kParams, [](const ModelContext& c) { return halen_spring::make(c); }},
+      {"halen_cascade", "Halén & Wester 2007 §4.3: cascading tangent spaces with up/down reference nodes (§5.9)",
+       halen_cascade::kParams, [](const ModelContext& c) { return halen_cascade::make(c); }},
+      {"halen_forest", "Halén & Wester 2007 §4.2 (Di Giacomo et al. 2001): joint angles, x-primary axes (§5.9)",
+       halen_forest::kParams, [](const ModelContext& c) { return halen_forest::make(c); }},
   };
   return models;
 }

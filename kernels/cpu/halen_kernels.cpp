@@ -1,0 +1,224 @@
+#include "kernels/cpu/halen_kernels.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hairbench::kernels {
+
+namespace {
+Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
+}  // namespace
+
+float falloff_stiffness(float k, float distance, float c, int exponent) {
+  const float lc = std::max(distance * c, 1.0f);
+  float d = 1.0f;
+  for (int i = 0; i < exponent; ++i) d *= lc;
+  return k / d;
+}
+
+void arc_lengths(std::span<const Vec4f> rest, std::span<float> out) {
+  out[0] = 0.0f;
+  for (std::size_t i = 1; i < rest.size(); ++i) out[i] = out[i - 1] + (xyz(rest[i]) - xyz(rest[i - 1])).norm();
+}
+
+float tilt_factor(const Vec3f& up, const Vec3f& head_up, float min_fraction) {
+  const float s = 0.5f * (up.dot(head_up) + 1.0f);
+  return s * (1.0f - min_fraction) + min_fraction;
+}
+
+void head_references(std::span<const Vec3f> local, std::span<const float> lift, const Affine3f& head,
+                     const Vec3f& gravity, std::span<Vec3f> ref) {
+  for (std::size_t i = 0; i < local.size(); ++i) ref[i] = head * local[i] - gravity * lift[i];
+}
+
+void add_spring_acceleration(std::span<Vec4f> pos, std::span<const Vec4f> prev, std::span<const Vec3f> ref,
+                             std::span<const float> k, float scale, float dt) {
+  const float dt2 = dt * dt;
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (pos[i].w() == 0.0f) continue;
+    pos[i].head<3>() += (scale * k[i] * dt2) * (ref[i] - xyz(prev[i]));
+  }
+}
+
+Mat3f root_tangent_space(const Vec3f& n) {
+  // Any T across the root segment will do; the cascade carries it to every segment.
+  Vec3f b = n.cross(Vec3f::UnitZ());
+  if (b.squaredNorm() < 1e-8f) b = n.cross(Vec3f::UnitX());
+  b.normalize();
+  Mat3f m;
+  m.col(0) = b;
+  m.col(1) = n;
+  m.col(2) = n.cross(b);
+  return m;
+}
+
+void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, std::span<Mat3f> space) {
+  space[0] = root;
+  space[1] = root;
+  for (std::size_t i = 2; i < pos.size(); ++i) {
+    const Vec3f d = xyz(pos[i]) - xyz(pos[i - 1]);
+    const float len = d.norm();
+    const Mat3f& parent = space[i - 1];
+    if (!(len > 0.0f)) {
+      space[i] = parent;
+      continue;
+    }
+    const Vec3f n = d / len;
+    Vec3f b = n.cross(parent.col(2));
+    const float bl = b.norm();
+    if (bl > 1e-6f)
+      b /= bl;
+    else
+      b = (parent.col(0) - parent.col(0).dot(n) * n).normalized();
+    space[i].col(0) = b;
+    space[i].col(1) = n;
+    space[i].col(2) = n.cross(b);
+  }
+}
+
+void cascade_references(std::span<const Vec4f> pos, std::span<const Mat3f> space,
+                        std::span<const Vec3f> up_local, std::span<const Vec3f> down_local,
+                        std::span<const float> lift, const Vec3f& gravity, std::span<Vec3f> up_ref,
+                        std::span<Vec3f> down_ref) {
+  const std::size_t n = pos.size();
+  for (std::size_t i = 2; i < n; ++i)
+    up_ref[i] = space[i - 1] * up_local[i] + xyz(pos[i - 1]) - gravity * lift[i];
+  for (std::size_t i = 0; i + 2 < n; ++i)
+    down_ref[i] = space[i + 2] * down_local[i] + xyz(pos[i + 2]) - gravity * lift[i];
+}
+
+namespace {
+Mat3f rotation_about(int axis, float angle) {
+  return Eigen::AngleAxisf(angle, Vec3f::Unit(axis)).toRotationMatrix();
+}
+int primary_axis(ForestAxes axes) { return axes == ForestAxes::ParentX ? 0 : 2; }
+}  // namespace
+
+Mat3f forest_joint_rotation(ForestAxes axes, float theta, float phi) {
+  return rotation_about(primary_axis(axes), theta) * rotation_about(1, phi);
+}
+
+void forest_angles(ForestAxes axes, const Vec3f& d, float& theta, float& phi) {
+  if (axes == ForestAxes::ParentZ) {
+    // R_z(θ) R_y(φ) z = (cos θ sin φ, sin θ sin φ, cos φ); straight (d = z) is the
+    // gimbal configuration where θ has no effect, taken as θ = 0.
+    phi = std::atan2(std::sqrt(d.x() * d.x() + d.y() * d.y()), d.z());
+    theta = (d.x() == 0.0f && d.y() == 0.0f) ? 0.0f : std::atan2(d.y(), d.x());
+  } else {
+    // R_x(θ) R_y(φ) z = (sin φ, -sin θ cos φ, cos θ cos φ).
+    phi = std::atan2(d.x(), std::sqrt(d.y() * d.y() + d.z() * d.z()));
+    theta = std::atan2(-d.y(), d.z());
+  }
+}
+
+Mat3f forest_root_frame(const Vec3f& z) {
+  Vec3f y = z.cross(Vec3f::UnitX());
+  if (y.squaredNorm() < 1e-8f) y = z.cross(Vec3f::UnitZ());
+  y.normalize();
+  Mat3f m;
+  m.col(0) = y.cross(z);
+  m.col(1) = y;
+  m.col(2) = z;
+  return m;
+}
+
+void forest_rest(std::span<const Vec4f> rest, ForestAxes axes, std::span<Mat3f> rest_frame,
+                 std::span<float> theta0, std::span<float> phi0, std::span<float> length) {
+  const std::size_t n = rest.size();
+  rest_frame[0] = forest_root_frame((xyz(rest[1]) - xyz(rest[0])).normalized());
+  theta0[0] = phi0[0] = 0.0f;
+  length[0] = 0.0f;
+  for (std::size_t i = 1; i < n; ++i) {
+    const Vec3f d = xyz(rest[i]) - xyz(rest[i - 1]);
+    length[i] = d.norm();
+    if (rest[i].w() == 0.0f) {
+      // Rigid with the head: its own direction, whatever the parent's.
+      rest_frame[i] = forest_root_frame(d / length[i]);
+      theta0[i] = phi0[i] = 0.0f;
+      continue;
+    }
+    const Mat3f& parent = rest_frame[i - 1];
+    forest_angles(axes, parent.transpose() * (d / length[i]), theta0[i], phi0[i]);
+    rest_frame[i] = parent * forest_joint_rotation(axes, theta0[i], phi0[i]);
+  }
+}
+
+void forest_pose(const ForestStrand& s, ForestAxes axes, const Affine3f& head) {
+  const Mat3f head_rotation = head.linear();
+  const std::size_t n = s.pos.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s.rest[i].w() == 0.0f) {
+      s.frame[i] = head_rotation * s.rest_frame[i];
+      s.pos[i].head<3>() = head * xyz(s.rest[i]);
+      continue;
+    }
+    s.frame[i] = s.frame[i - 1] * forest_joint_rotation(axes, s.theta[i], s.phi[i]);
+    s.pos[i].head<3>() = xyz(s.pos[i - 1]) + s.length[i] * s.frame[i].col(2);
+  }
+}
+
+namespace {
+// External acceleration at a free segment end: gravity, the part of the wind that meets
+// the segment face-on (as verlet_integrate), the inertial force of the moving root, and
+// a penalty pushing the end out of any sphere it is inside.
+Vec3f external_acceleration(const ForestForces& f, const Vec3f& p, const Vec3f& z) {
+  const Vec3f root = f.inertia.leftCols<3>() * p + f.inertia.col(3);
+  Vec3f a = f.gravity - root;
+  if (f.wind.active()) {
+    const Vec3f w = f.wind.acceleration();
+    a += w - w.dot(z) * z;
+  }
+  const float push = f.collision_stiffness / (f.dt * f.dt);
+  for (const Vec4f& sphere : f.spheres) {
+    const Vec3f d = p - xyz(sphere);
+    const float r = sphere.w();
+    const float dist2 = d.squaredNorm();
+    if (dist2 >= r * r) continue;
+    const float dist = std::sqrt(dist2);
+    const Vec3f normal = dist > 0.0f ? Vec3f(d / dist) : Vec3f::UnitY();
+    a += push * (r - dist) * normal;
+  }
+  return a;
+}
+}  // namespace
+
+void forest_integrate(const ForestStrand& s, ForestAxes axes, const ForestForces& f) {
+  const std::size_t n = s.pos.size();
+  const int primary = primary_axis(axes);
+  // Eq. 4.2.2: each joint's spring torque (kθ + vθ')a_p + (kφ + vφ')y, a_p the parent's
+  // primary axis (z originally, x with §5.9's fix) and y the joint's y axis.
+  for (std::size_t i = 1; i < n; ++i) {
+    if (s.rest[i].w() == 0.0f) {
+      s.joint_torque[i] = Vec3f::Zero();
+      continue;
+    }
+    const Vec3f a = s.frame[i - 1].col(primary);
+    const Vec3f y = s.frame[i].col(1);
+    s.joint_torque[i] = (s.k[i] * (s.theta[i] - s.theta0[i]) + f.joint_damping * s.dtheta[i]) * a +
+                        (s.k[i] * (s.phi[i] - s.phi0[i]) + f.joint_damping * s.dphi[i]) * y;
+  }
+  Vec3f parent_acc = Vec3f::Zero();  // the head-rigid root: its motion is in f.inertia
+  for (std::size_t i = 1; i < n; ++i) {
+    if (s.rest[i].w() == 0.0f) continue;
+    const Vec3f z = s.frame[i].col(2);
+    const Vec3f p = xyz(s.pos[i]);
+    const Vec3f rest_z = f.head_rotation * s.rest_frame[i].col(2);
+    // Eq. 4.2.1 and 4.2.3: external torque less gravity's torque on the rest segment,
+    // minus the joint's own spring, plus its child's.
+    Vec3f acc = f.inv_inertia_length * (z.cross(external_acceleration(f, p, z)) - rest_z.cross(f.gravity)) -
+                s.joint_torque[i];
+    if (i + 1 < n) acc += s.joint_torque[i + 1];
+    // Eq. 4.2.5: relative to the parent, projected on the joint axes.
+    const Vec3f rel = acc - parent_acc;
+    parent_acc = acc;
+    const float ddtheta = s.frame[i - 1].col(primary).dot(rel);
+    const float ddphi = s.frame[i].col(1).dot(rel);
+    // Eq. 4.2.6: explicit Euler, the angle advanced with the velocity of the step's start.
+    s.theta[i] += s.dtheta[i] * f.dt;
+    s.phi[i] += s.dphi[i] * f.dt;
+    s.dtheta[i] += ddtheta * f.dt;
+    s.dphi[i] += ddphi * f.dt;
+  }
+}
+
+}  // namespace hairbench::kernels

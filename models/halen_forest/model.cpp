@@ -1,0 +1,123 @@
+#include "models/halen_forest/model.h"
+
+#include "core/parallel.h"
+
+namespace hairbench::halen_forest {
+
+namespace k = hairbench::kernels;
+
+ForestModel::ForestModel(const ModelContext& ctx) : ctx_(ctx) {}
+
+void ForestModel::reset(const Groom& rest, const ParamSet& params) {
+  rest_ = rest;
+  axes_ = params.get_int("axis_convention") == 0 ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
+  substeps_ = params.get_int("substeps");
+  joint_damping_.clear();
+  collision_stiffness_.clear();
+  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
+    joint_damping_.push_back(static_cast<float>(params.get("joint_damping", r)));
+    collision_stiffness_.push_back(static_cast<float>(params.get("collision_stiffness", r)));
+  }
+
+  const std::size_t nv = rest.vertex_count();
+  rest_frame_.assign(nv, k::Mat3f::Identity());
+  length_.assign(nv, 0.0f);
+  theta0_.assign(nv, 0.0f);
+  phi0_.assign(nv, 0.0f);
+  k_.assign(nv, 0.0f);
+  inv_strand_length_.assign(rest.strand_count(), 0.0f);
+  std::vector<float> arc(nv);
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
+    const auto strand_rest = std::span(rest.positions).subspan(b, n);
+    k::forest_rest(strand_rest, axes_, std::span(rest_frame_).subspan(b, n), std::span(theta0_).subspan(b, n),
+                   std::span(phi0_).subspan(b, n), std::span(length_).subspan(b, n));
+    k::arc_lengths(strand_rest, std::span(arc).subspan(b, n));
+    inv_strand_length_[s] = 1.0f / arc[b + n - 1];
+    const float stiffness = static_cast<float>(params.get("joint_stiffness", r));
+    const float c = static_cast<float>(params.get("falloff_scale", r));
+    const int a = params.get_int("falloff_exponent", r);
+    // The joint of segment i sits at vertex i-1.
+    for (std::size_t i = 1; i < n; ++i) k_[b + i] = k::falloff_stiffness(stiffness, arc[b + i - 1], c, a);
+  }
+  theta_ = theta0_;
+  phi_ = phi0_;
+  dtheta_.assign(nv, 0.0f);
+  dphi_.assign(nv, 0.0f);
+  frame_ = rest_frame_;
+  joint_torque_.assign(nv, Vec3f::Zero());
+  pos_ = rest.positions;
+  head_hist_[0] = head_hist_[1] = Affine3f::Identity();
+  pose(Affine3f::Identity());
+}
+
+k::ForestStrand ForestModel::strand_view(std::size_t s) {
+  const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+  return {std::span<const Vec4f>(rest_.positions).subspan(b, n),
+          std::span<const k::Mat3f>(rest_frame_).subspan(b, n),
+          std::span<const float>(length_).subspan(b, n),
+          std::span<const float>(theta0_).subspan(b, n),
+          std::span<const float>(phi0_).subspan(b, n),
+          std::span<const float>(k_).subspan(b, n),
+          std::span(theta_).subspan(b, n),
+          std::span(phi_).subspan(b, n),
+          std::span(dtheta_).subspan(b, n),
+          std::span(dphi_).subspan(b, n),
+          std::span(frame_).subspan(b, n),
+          std::span(joint_torque_).subspan(b, n),
+          std::span(pos_).subspan(b, n)};
+}
+
+template <class F>
+void ForestModel::for_each_strand(F&& f) {
+  ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) f(s);
+  });
+}
+
+void ForestModel::pose(const Affine3f& head) {
+  for_each_strand([&](std::size_t s) { k::forest_pose(strand_view(s), axes_, head); });
+}
+
+void ForestModel::step(const FrameInput& in, StageTimes& times) {
+  const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  for (int i = 1; i <= substeps_; ++i) {
+    const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(substeps_));
+    {
+      StageTimer t(times, "pose");
+      pose(head);
+    }
+    StageTimer t(times, "integrate");
+    // The acceleration of a point rigid with the head, by central differences of the
+    // head transform over the last three substeps: a(p) = (H_s - 2H_{s-1} + H_{s-2}) H_s^-1 p / dt².
+    k::ForestForces f;
+    f.gravity = in.gravity;
+    f.wind = in.wind;
+    f.head_rotation = head.linear();
+    const Eigen::Matrix4f second = head.matrix() - 2.0f * head_hist_[1].matrix() + head_hist_[0].matrix();
+    f.inertia = (second * head.inverse(Eigen::Isometry).matrix()).topRows<3>() / (dt * dt);
+    head_hist_[0] = head_hist_[1];
+    head_hist_[1] = head;
+    spheres_.clear();
+    for (const Sphere& c : in.colliders) {
+      const Vec3f center = collider_center(c, head);
+      spheres_.emplace_back(center.x(), center.y(), center.z(), c.radius);
+    }
+    f.spheres = spheres_;
+    f.dt = dt;
+    for_each_strand([&](std::size_t s) {
+      k::ForestForces fs = f;
+      const std::size_t r = rest_.strand_region[s];
+      fs.joint_damping = joint_damping_[r];
+      fs.collision_stiffness = collision_stiffness_[r];
+      fs.inv_inertia_length = inv_strand_length_[s];
+      k::forest_integrate(strand_view(s), axes_, fs);
+    });
+  }
+  StageTimer t(times, "pose");
+  pose(in.head);
+}
+
+std::unique_ptr<HairModel> make(const ModelContext& ctx) { return std::make_unique<ForestModel>(ctx); }
+
+}  // namespace hairbench::halen_forest

@@ -1,0 +1,35 @@
+// Parameters of Halén & Wester 2007's spring model (§4.4 with §5.9's falloff).
+//
+// Stiffnesses are per unit node mass (s^-2: acceleration per metre of spring stretch),
+// so the node mass m of L = mg/k cancels. Defaults are chosen for real gravity, 25 cm
+// strands of 16 vertices and 60 Hz frames: k = 900 s^-2 at the root, falling
+// quadratically past 20 cm (k/1.56 at the tip). A steeper falloff (c = 25: k/39 at the
+// tip) lets the weak tip springs' equilibria, each g/k_m below its rest node, crowd
+// closer together than the segment length once the head tilts, and the strand folds
+// into zig-zags (jaggedness 1-10 on `nod` and `tilt_upside_down`): the spring model has
+// no bending stiffness of its own. Six substeps with six edge corrections keep edges
+// within 1% RMS on `shake`.
+#pragma once
+
+#include "core/params.h"
+
+#include <array>
+
+namespace hairbench::halen_spring {
+
+inline constexpr std::array<ParamSpec, 7> kParams{{
+    {"damping", 0.04, 0.0, 1.0, false,
+     "fraction of velocity removed per substep in Verlet (Eq. 4.1: k = 1 - damping)"},
+    {"stiffness", 900.0, 0.0, 1e6, false,
+     "k: spring strength at the root per unit node mass, s^-2 (§4.4, §5.9)"},
+    {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
+    {"falloff_scale", 5.0, 0.0, 1e4, false,
+     "c of §5.9, 1/m: the strength is k up to L = 1/c from the root, then falls as (L c)^-a"},
+    {"tilt_min", 0.3, 0.0, 1.0, false,
+     "alpha/k of §4.4's k_m: the fraction of the strength kept with the head upside down; 1 turns "
+     "the tilt weakening off"},
+    {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep"},
+    {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
+}};
+
+}  // namespace hairbench::halen_spring
