@@ -2,6 +2,8 @@
 
 #include "models/han/model.h"
 #include "models/han/settings.h"
+#include "models/plante_wisp/model.h"
+#include "models/plante_wisp/settings.h"
 
 #include <vector>
 
@@ -15,6 +17,8 @@ std::span<const ModelInfo> model_registry() {
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Jacobi, c); }},
       {"han_m3", "Han & Harada 2012 method 3: rest-state transforms (Algorithm 5)",
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::RestFrames, c); }},
+      {"plante_wisp", "Plante, Cani & Poulin 2001: layered wisps (skeleton, envelope, strands) with anisotropic interactions (§3-5)",
+       plante::kParams, [](const ModelContext& c) { return plante::make_plante_wisp(c); }},
   };
   return models;
 }
