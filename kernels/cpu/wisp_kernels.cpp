@@ -349,8 +349,15 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       const float cc = xc.squaredNorm() - R * R;
       const float t = -bb - std::sqrt(std::max(bb * bb - cc, 0.0f));
       s.r[ei] = std::clamp(t, kMinRadiusFraction * s.r_rest[k], s.r[ei]);
-      const Vec3f p = s.x[k] + s.r[ei] * dir;
+      Vec3f p = s.x[k] + s.r[ei] * dir;
       const Vec3f nrm = unit_or(p - c, Vec3f::UnitY());
+      // Compressed to its floor and still inside (the skeleton mass lies closer to the
+      // surface than that): the skeleton mass moves out so that the section fits.
+      const float depth = R - (p - c).norm();
+      if (depth > 0.0f) {
+        s.x[k] += depth * nrm;
+        p += depth * nrm;
+      }
       const float vn = (s.v[k] + s.rdot[ei] * dir - body.surface_velocity(i, p)).dot(nrm);
       if (vn < 0.0f) s.rdot[ei] -= vn * nrm.dot(dir);
     }
@@ -443,15 +450,15 @@ void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts,
     const Vec3f rel = vp - vs;
 
     // §4.1: quasi-parallel wisps lie in one plane and move roughly within it. Its normal
-    // is sigma_p x sigma_s in the paper; for nearly parallel wisps that product vanishes,
-    // so the plane through the segment's axis and the point (which holds both wisps) is
-    // used instead - the same plane whenever both are defined.
+    // is sigma_p x sigma_s; for wisps within a few degrees of parallel that product
+    // vanishes, and the plane through the segment's axis and the point (which holds both
+    // wisps) is used instead.
     Vec3f dv = -rel;  // very dissipative collision by default: contact velocities averaged
     bool parallel = std::abs(sigma_p.dot(sigma_s)) >= ip.parallel_cos;
     if (parallel) {
-      const Vec3f lateral = p - (s.x[a] + c.u * axis);
-      Vec3f nrm = sigma_s.cross(lateral);
-      if (nrm.squaredNorm() < 1e-16f) nrm = sigma_p.cross(sigma_s);
+      constexpr float kMinSin = 0.087f;  // sin 5°
+      Vec3f nrm = sigma_p.cross(sigma_s);
+      if (nrm.squaredNorm() < kMinSin * kMinSin) nrm = sigma_s.cross(p - (s.x[a] + c.u * axis));
       nrm = unit_or(nrm, sigma_s.unitOrthogonal());
       const float out_of_plane = rel.dot(nrm);
       parallel = std::abs(out_of_plane) <= ip.in_plane_sin * rel.norm();
@@ -483,10 +490,15 @@ void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts,
       s.node_dv_weight[k] += 1.0f;
       impulse = dvp;
     }
+    // The segment's nodes take the opposite impulse, shared linearly. In the average
+    // over a node's contacts, a contact counts by the share of the relative velocity it
+    // asks the node to absorb (1 for an equal mass, less for a light envelope mass), so
+    // that many light contacts do not dilute a heavy one.
+    const float share = 2.0f * mp / (1.0f + mp);
     for (const auto& [node, weight] : {std::pair{a, 1.0f - c.u}, std::pair{a + 1, c.u}}) {
       if (s.pinned[node]) continue;
       s.node_dv[node] -= weight * impulse;
-      s.node_dv_weight[node] += weight;
+      s.node_dv_weight[node] += weight * share;
     }
   }
   // Several contacts on one mass: their modifications are averaged, in list order.

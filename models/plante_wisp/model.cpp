@@ -19,11 +19,13 @@ namespace {
 
 Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
 
-// Squared distance between two rest strands of equal vertex count, over all vertices.
+// Squared distance between a rest strand and a cluster centre of equal vertex count:
+// the root weighs as much as the rest of the strand together, so wisps stay compact at
+// the scalp, where the strands are pinned and the rebuild cannot bend them apart.
 float strand_distance2(const Groom& g, std::uint32_t s, const std::vector<Vec3f>& centre, std::size_t j, std::size_t n) {
-  float d = 0.0f;
   const std::uint32_t b = g.strand_begin(s);
-  for (std::size_t i = 0; i < n; ++i) d += (xyz(g.positions[b + i]) - centre[j * n + i]).squaredNorm();
+  float d = static_cast<float>(n) * (xyz(g.positions[b]) - centre[j * n]).squaredNorm();
+  for (std::size_t i = 1; i < n; ++i) d += (xyz(g.positions[b + i]) - centre[j * n + i]).squaredNorm();
   return d;
 }
 
@@ -216,7 +218,11 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
   const float h = static_cast<float>(in.dt / steps);
   const double t0 = in.t - in.dt;
   auto crosses = [&](double rate, int i) {
-    return rate > 0.0 && std::floor((t0 + i * (in.dt / steps)) * rate) > std::floor((t0 + (i - 1) * (in.dt / steps)) * rate);
+    // The epsilon keeps a period boundary that falls on a step's end (in exact
+    // arithmetic) on that step despite rounding.
+    constexpr double kEps = 1e-9;
+    return rate > 0.0 && std::floor((t0 + i * (in.dt / steps)) * rate + kEps) >
+                             std::floor((t0 + (i - 1) * (in.dt / steps)) * rate + kEps);
   };
   Affine3f head_before = in.head_prev;
   for (int i = 1; i <= steps; ++i) {

@@ -30,12 +30,14 @@ class PlanteWispModel final : public HairModel {
   // (kernels::strand_coord, relative to the node of the same index).
   std::span<const std::uint32_t> strand_wisp() const { return strand_wisp_; }
   std::span<const Vec4f> section_coords() const { return coord_; }
+  // Rebuilds positions() from the current wisp state under head transform `head` (done
+  // at the end of every step; public so that tests can rebuild from an edited state).
+  void rebuild(const Affine3f& head);
   // Contacts of the last wisp-wisp detection.
   std::span<const kernels::WispContact> contacts() const { return contacts_; }
 
  private:
   void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend);
-  void rebuild(const Affine3f& head);
   template <class F>
   void for_each_wisp(F&& f);
   void detect_self_interactions();
