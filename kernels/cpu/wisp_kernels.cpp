@@ -84,7 +84,10 @@ SectionFrame section_frame(const WispSystem& s, std::uint32_t k, float sfrac, co
   const float* rk = &s.r[kEnvelopePerSection * k];
   const float* rj = &s.r[kEnvelopePerSection * j];
   const float ik = 1.0f / s.r_rest[k], ij = 1.0f / s.r_rest[j];
-  auto scale = [&](int q) { return lerp(rk[q] * ik, rj[q] * ij, u); };
+  // Near the root the envelope's scale is blended towards 1 like the axes: a strand
+  // next to its own root is not squeezed towards the wisp's centre.
+  const float wk = s.frame_weight[k], wj = s.frame_weight[j];
+  auto scale = [&](int q) { return lerp(wk * rk[q] * ik + (1.0f - wk), wj * rj[q] * ij + (1.0f - wj), u); };
   f.scale_a[0] = scale(0);
   f.scale_b[0] = scale(1);
   f.scale_a[1] = scale(2);

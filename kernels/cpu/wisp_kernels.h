@@ -103,8 +103,8 @@ inline Vec3f envelope_point(const WispSystem& s, std::size_t k, int q) {
 // way, a strand whose vertices sit a little ahead of or behind the wisp's nodes still
 // bends with the wisp instead of swinging about the nodes' normals.
 //
-// Near the root the section axes are blended towards the head-carried rest axes
-// (frame_weight): every strand is rooted at its own point of the scalp and bends there,
+// Near the root the section axes (and the envelope's scale, towards 1) are blended
+// towards the head-carried rest axes (frame_weight): every strand is rooted at its own point of the scalp and bends there,
 // whereas a wide wisp's section swinging about the wisp's centre would carry the strand
 // offsets (up to the wisp's radius) through the same angle and stretch the first free
 // strand edges by up to radius x angle - more than the edge itself for a centimetre-wide
