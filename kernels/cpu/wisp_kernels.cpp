@@ -478,7 +478,6 @@ void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts,
       }
     }
 
-
     // Momentum-conserving split between the point (mass mp) and the segment's skeleton
     // (unit masses): equal masses give the paper's Delta v_p = -(...)/2.
     const Vec3f dvp = dv * (1.0f / (1.0f + mp));
