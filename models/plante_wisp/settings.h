@@ -11,7 +11,11 @@
 // Stiffnesses are accelerations per metre (1/s^2) of the mass they act on, dampings
 // 1/s: the defaults keep the explicit integration stable at 1000 Hz with the highest
 // axial mode at omega h ~ 1.3 (< 2), and hold a 16-vertex, 25 cm wisp within ~2% of its
-// rest length under gravity. They are not the paper's (it gives none).
+// rest length under gravity. The bending springs, whose targets turn with the frames
+// propagated from the root, go unstable at 1000 Hz above about 1e4 1/s^2 (measured on
+// `idle` without gravity); 5e3 leaves the hair sagging onto the scalp under gravity
+// (rest_shape_error ~0.13 L-bar on `idle`: nothing but bending holds the style, §3.2).
+// They are not the paper's (it gives none).
 #pragma once
 
 #include "core/params.h"
@@ -23,7 +27,7 @@ namespace hairbench::plante {
 inline constexpr std::array<ParamSpec, 24> kParams{{
     {"strands_per_wisp", 3, 1, 10000, true,
      "groom strands per wisp when `wisps` is 0: wisps = round(strands / strands_per_wisp) (§3.1)"},
-    {"wisps", 0, 0, 1000000, true, "number of wisps (0: from strands_per_wisp); clustering is k-means on roots"},
+    {"wisps", 0, 0, 1000000, true, "number of wisps (0: from strands_per_wisp); root-weighted k-means on the rest strands"},
     {"wisp_radius_min", 0.003, 1e-5, 1.0, false,
      "smallest rest envelope radius, metres (a wisp of one strand has no spread of its own)"},
     {"root_blend", 3, 0, 64, true,
