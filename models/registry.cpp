@@ -8,6 +8,8 @@
 #include "models/halen_forest/settings.h"
 #include "models/halen_spring/model.h"
 #include "models/halen_spring/settings.h"
+#include "models/plante_wisp/model.h"
+#include "models/plante_wisp/settings.h"
 
 #include <vector>
 
@@ -27,6 +29,8 @@ std::span<const ModelInfo> model_registry() {
        halen_cascade::kParams, [](const ModelContext& c) { return halen_cascade::make(c); }},
       {"halen_forest", "Halén & Wester 2007 §4.2 (Di Giacomo et al. 2001): joint angles, x-primary axes (§5.9)",
        halen_forest::kParams, [](const ModelContext& c) { return halen_forest::make(c); }},
+      {"plante_wisp", "Plante, Cani & Poulin 2001: layered wisps (skeleton, envelope, strands) with anisotropic interactions (§3-5)",
+       plante::kParams, [](const ModelContext& c) { return plante::make_plante_wisp(c); }},
   };
   return models;
 }

@@ -1,0 +1,62 @@
+// Parameters of Plante, Cani & Poulin 2001's layered wisp model (models/plante_wisp).
+//
+// Rates (§5.3): explicit integration at 1000 Hz, body collision detection at 120 Hz,
+// wisp self-interaction detection at 24 Hz. A frame is consumed in ceil(dt * rate)
+// equal integration steps; a detection runs on the step that crosses a multiple of its
+// period, and body collisions also on a frame's last step, so that no mass ends a frame
+// inside a body (the harness measures after each frame). A rate of 0 switches that
+// interaction off. The contacts a detection finds get their velocity modifications
+// (§5.1 step 3) in that step; the viscous drags stand for the detection period.
+//
+// Stiffnesses are accelerations per metre (1/s^2) of the mass they act on, dampings
+// 1/s: the defaults keep the explicit integration stable at 1000 Hz with the highest
+// axial mode at omega h ~ 1.3 (< 2), and hold a 16-vertex, 25 cm wisp within ~2% of its
+// rest length under gravity. The bending springs, whose targets turn with the frames
+// propagated from the root, go unstable at 1000 Hz above about 1e4 1/s^2 (measured on
+// `idle` without gravity); 5e3 leaves the hair sagging onto the scalp under gravity
+// (rest_shape_error ~0.13 L-bar on `idle`: nothing but bending holds the style, §3.2).
+// They are not the paper's (it gives none).
+#pragma once
+
+#include "core/params.h"
+
+#include <array>
+
+namespace hairbench::plante {
+
+inline constexpr std::array<ParamSpec, 24> kParams{{
+    {"strands_per_wisp", 3, 1, 10000, true,
+     "groom strands per wisp when `wisps` is 0: wisps = round(strands / strands_per_wisp) (§3.1)"},
+    {"wisps", 0, 0, 1000000, true, "number of wisps (0: from strands_per_wisp); root-weighted k-means on the rest strands"},
+    {"wisp_radius_min", 0.003, 1e-5, 1.0, false,
+     "smallest rest envelope radius, metres (a wisp of one strand has no spread of its own)"},
+    {"root_blend", 3, 0, 64, true,
+     "free nodes over which the strand rebuild turns from head-carried to section axes (0: the paper's layer)"},
+    {"integration_hz", 1000, 1, 100000, false, "explicit integration rate (§5.3: 1000 Hz)"},
+    {"collision_hz", 120, 0, 100000, false, "wisp-body collision detection rate (§5.3: 120 Hz); 0 off"},
+    {"interaction_hz", 24, 0, 100000, false, "wisp-wisp interaction detection rate (§5.3: 24 Hz); 0 off"},
+    {"air_drag", 5.0, 0, 1000, false, "air resistance on every mass, 1/s (§5.1 step 1)"},
+    {"axial_stiffness", 4e5, 0, 1e7, false, "linear axial springs of the skeleton, 1/s^2 (§3.2)"},
+    {"axial_damping", 40, 0, 1000, false, "damping of the axial springs, 1/s (§3.2)"},
+    {"bending_stiffness", 5e3, 0, 1e6, false,
+     "bending springs: lateral acceleration = k * angle * segment rest length, 1/s^2 (§3.2)"},
+    {"bending_damping", 60, 0, 1000, false, "damping of the relative lateral velocity, 1/s (§3.2)"},
+    {"envelope_mass", 0.1, 1e-3, 1, false, "envelope mass / skeleton mass (§3.3: much lighter)"},
+    {"radial_stiffness", 5e4, 0, 1e6, false,
+     "envelope-skeleton springs at rest, 1/s^2; compression stiffens as r0/r (§3.3)"},
+    {"radial_stretch", 0.3, 0, 1, false, "stretch stiffness of the radial springs as a fraction of compression"},
+    {"radial_damping", 300, 0, 1000, false, "damping of the radial springs, 1/s (highly viscous, §3.3)"},
+    {"ring_stiffness", 1e4, 0, 1e6, false, "soft springs between a section's envelope masses, 1/s^2 (§3.3)"},
+    {"ring_damping", 200, 0, 1000, false, "damping of the ring springs, 1/s (highly damped, §3.3)"},
+    {"contact_threshold", 0.002, 0, 0.1, false, "sliding contact distance to a body, metres (§4.2)"},
+    {"body_friction", 20, 0, 10000, false, "viscous tangential drag against a body, 1/s (§4.2)"},
+    {"hair_friction", 5, 0, 10000, false,
+     "viscous drag between quasi-parallel wisps, 1/s at rest density (x density x dt, §4.1)"},
+    {"parallel_angle", 30, 0, 90, false, "degrees: widest angle between wisps treated as quasi-parallel (§4.1)"},
+    {"in_plane_angle", 30, 0, 90, false,
+     "degrees: widest angle between their relative velocity and their plane (§4.1)"},
+    {"threads_min_wisps", 64, 1, 1000000, true,
+     "below this many wisps a step runs on one thread (thread hand-offs cost more than the work)"},
+}};
+
+}  // namespace hairbench::plante

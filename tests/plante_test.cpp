@@ -1,0 +1,283 @@
+// Properties Plante, Cani & Poulin 2001 claims for the layered wisp model (§3-§5),
+// checked on hand-built wisp pairs and on the built-in scenarios.
+#include "models/plante_wisp/model.h"
+#include "models/plante_wisp/settings.h"
+#include "reports/metrics.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hairbench {
+namespace {
+
+using test::builtin;
+
+ParamSet plante_params(const Groom& g, std::vector<std::pair<std::string, double>> set = {}) {
+  ParamSet p(plante::kParams, g.region_names.size());
+  for (const auto& [name, v] : set) p.set(name, v, {"test", ""});
+  return p;
+}
+
+// A strand of `n` vertices from `start` along `step`; vertices 0 and 1 are pinned.
+void add_line(Groom& g, const Vec3f& start, const Vec3f& step, int n) {
+  std::vector<Vec3f> pts;
+  for (int i = 0; i < n; ++i) pts.push_back(start + static_cast<float>(i) * step);
+  g.add_strand(pts, 0);
+}
+
+// Steps a model `frames` frames of length dt with the head still, no gravity, no
+// colliders; calls check(frame) after each.
+template <class F>
+void run_still(plante::PlanteWispModel& m, int frames, F&& check, double dt = 1.0 / 60.0) {
+  StageTimes times;
+  for (int f = 0; f < frames; ++f) {
+    FrameInput in;
+    in.frame = f;
+    in.dt = dt;
+    in.t = (f + 1) * in.dt;
+    m.step(in, times);
+    check(f);
+  }
+}
+
+// Two single-strand wisps of radius 2 cm: A hangs along -y through the origin, B lies
+// along +x, 5 cm in front of A (z).
+struct Crossing {
+  Groom groom;
+  Crossing() {
+    add_line(groom, Vec3f(0.0f, 0.10f, 0.0f), Vec3f(0.0f, -0.02f, 0.0f), 11);   // A: node 5 at the origin
+    add_line(groom, Vec3f(-0.10f, 0.0f, 0.05f), Vec3f(0.02f, 0.0f, 0.0f), 11);  // B: node 5 at x = 0
+  }
+};
+
+double crossing_gap(const plante::PlanteWispModel& m) {
+  const auto& s = m.wisps();
+  const std::uint32_t a5 = s.node_begin[m.strand_wisp()[0]] + 5, b5 = s.node_begin[m.strand_wisp()[1]] + 5;
+  return s.x[b5].z() - s.x[a5].z();
+}
+
+// §4.1, Figure 2 (right): wisps of different orientations collide - the velocities of
+// the contact points are averaged, so a wisp thrown across another is stopped by it
+// instead of passing through: B, thrown at A at 0.3 m/s, never gets its axis past A's.
+// Without interactions (interaction_hz 0) the same throw carries B's axis beyond A's
+// envelope, so the test tells the two apart. At the paper's 24 Hz detection a mass moves
+// 1.25 cm between detections, less than the wisp radius, so B's skeleton is caught
+// inside A before it reaches A's axis.
+TEST(PlanteWisp, CrossingWispsDoNotPassThrough) {
+  for (const double hz : {24.0, 0.0}) {
+    Crossing c;
+    plante::PlanteWispModel m(ModelContext{nullptr});
+    m.reset(c.groom, plante_params(c.groom, {{"strands_per_wisp", 1}, {"wisp_radius_min", 0.02}, {"interaction_hz", hz},
+                                              {"air_drag", 0}, {"bending_stiffness", 0}}));
+    auto& s = m.wisps();
+    const std::uint32_t wb = m.strand_wisp()[1];
+    for (std::uint32_t k = s.node_begin[wb]; k < s.node_begin[wb + 1]; ++k)
+      if (!s.pinned[k]) s.v[k] = Vec3f(0.0f, 0.0f, -0.3f);
+    double min_gap = crossing_gap(m);
+    bool touched = false;
+    run_still(m, 60, [&](int) {
+      min_gap = std::min(min_gap, crossing_gap(m));
+      touched = touched || !m.contacts().empty();
+    });
+    if (hz > 0.0) {
+      EXPECT_GT(min_gap, 0.0) << "B's axis crossed A's";
+      EXPECT_TRUE(touched);
+    } else {
+      EXPECT_LT(crossing_gap(m), -0.02) << "without interactions B should pass through A's envelope";
+    }
+  }
+}
+
+// §4.1, Figure 2 (left): quasi-parallel wisps interpenetrate; the relative velocity
+// normal to their plane is removed (both take the average), the in-plane one is only
+// dragged viscously. A hangs along -y in the plane z = 0; B, 15° from it in the same
+// plane, crosses it at node 4 (overlapping: radius 1 cm) and moves along x (in the
+// plane) and a little along z (out of it).
+TEST(PlanteWisp, ParallelWispsInterpenetrateAndLoseNormalVelocity) {
+  Groom g;
+  const float tilt = 15.0f * static_cast<float>(M_PI) / 180.0f;
+  const Vec3f step_b = 0.02f * Vec3f(std::sin(tilt), -std::cos(tilt), 0.0f);
+  add_line(g, Vec3f(0.0f, 0.10f, 0.0f), Vec3f(0.0f, -0.02f, 0.0f), 11);
+  add_line(g, Vec3f(-4.0f * step_b.x(), 0.10f, 0.0f), step_b, 11);
+  plante::PlanteWispModel m(ModelContext{nullptr});
+  m.reset(g, plante_params(g, {{"strands_per_wisp", 1}, {"wisp_radius_min", 0.01}, {"air_drag", 0},
+                               {"bending_stiffness", 0}}));
+  auto& s = m.wisps();
+  const std::uint32_t a = s.node_begin[m.strand_wisp()[0]], b = s.node_begin[m.strand_wisp()[1]];
+  const Vec3f v0(0.08f, 0.0f, 0.03f);  // out of plane: 0.03 / |v0| = 0.35 < sin 30°
+  for (std::uint32_t k = b; k < b + 11; ++k)
+    if (!s.pinned[k]) s.v[k] = v0;
+  // One frame of 1/24 s: one detection, on its last integration step.
+  run_still(m, 1, [](int) {}, 1.0 / 24.0);
+  ASSERT_FALSE(m.contacts().empty());
+  const int mid = 4;
+  const Vec3f rel = s.v[b + mid] - s.v[a + mid];
+  EXPECT_LT(std::abs(rel.z()), 0.1 * v0.z()) << "normal relative velocity should be averaged away";
+  EXPECT_GT(s.v[a + mid].z(), 0.25 * v0.z()) << "A takes its share of the normal velocity";
+  EXPECT_GT(rel.x(), 0.5 * v0.x()) << "in-plane relative velocity is only dragged, not stopped";
+  // No push apart: B's skeleton is still inside A's envelope (radius 1 cm).
+  const Vec3f d = s.x[b + mid] - s.x[a + mid];
+  EXPECT_LT(std::hypot(d.x(), d.z()), 0.01);
+}
+
+// The scenario runner's frame input for frame f.
+FrameInput frame_input(const Scenario& sc, int f) {
+  FrameInput in;
+  in.frame = f;
+  in.dt = sc.dt;
+  in.t = (f + 1) * sc.dt;
+  in.head_prev = sc.head.at(f * sc.dt);
+  in.head = sc.head.at(in.t);
+  in.gravity = sc.gravity;
+  in.wind = sc.wind.at(in.t);
+  in.colliders = sc.colliders;
+  return in;
+}
+
+// §4.2: after every step no skeleton or envelope mass is inside the head sphere or any
+// collider (the penetration reaction runs on a frame's last integration step).
+TEST(PlanteWisp, NoWispMassInsideABody) {
+  for (const char* name : {"shake", "nod", "spin_fast", "tilt_upside_down"}) {
+    const Scenario sc = builtin(name, 8);
+    plante::PlanteWispModel m(ModelContext{nullptr});
+    m.reset(sc.groom, plante_params(sc.groom));
+    StageTimes times;
+    double deepest = 0.0;
+    for (int f = 0; f < 90; ++f) {
+      const FrameInput in = frame_input(sc, f);
+      m.step(in, times);
+      const auto& s = m.wisps();
+      for (const Sphere& c : sc.colliders) {
+        const Vec3f centre = collider_center(c, in.head);
+        for (std::size_t k = 0; k < s.node_count(); ++k) {
+          if (s.pinned[k]) continue;
+          deepest = std::max(deepest, double(c.radius - (s.x[k] - centre).norm()));
+          for (int q = 0; q < kernels::kEnvelopePerSection; ++q)
+            deepest = std::max(deepest, double(c.radius - (kernels::envelope_point(s, k, q) - centre).norm()));
+        }
+      }
+    }
+    EXPECT_LT(deepest, 1e-5) << name;
+  }
+}
+
+// §3.4/§5.2: every strand stays within its wisp's envelope - its point in the section
+// it belongs to lies within the quarter-ellipses spanned by the four envelope masses.
+// Near the root the rebuild uses head-carried axes (settings.h: root_blend); from the
+// first node with the section's own axes on, the strand must be inside.
+TEST(PlanteWisp, StrandsStayInsideTheirEnvelope) {
+  const Scenario sc = builtin("shake", 8);
+  plante::PlanteWispModel m(ModelContext{nullptr});
+  m.reset(sc.groom, plante_params(sc.groom));
+  StageTimes times;
+  double worst = 0.0;
+  std::size_t checked = 0;
+  for (int f = 0; f < 90; ++f) {
+    const FrameInput in = frame_input(sc, f);
+    m.step(in, times);
+    const auto& s = m.wisps();
+    const auto p = m.positions();
+    for (std::size_t st = 0; st < sc.groom.strand_count(); ++st) {
+      const std::uint32_t nb = s.node_begin[m.strand_wisp()[st]];
+      for (std::uint32_t i = 0; i < sc.groom.strand_size(st); ++i) {
+        const std::uint32_t v = sc.groom.strand_begin(st) + i, k = nb + i;
+        const Vec4f c = m.section_coords()[v];
+        const std::uint32_t j = c.x() > 0 ? k + 1 : c.x() < 0 ? k - 1 : k;
+        if (s.frame_weight[k] < 1.0f || s.frame_weight[j] < 1.0f) continue;
+        const auto fr = kernels::section_frame(s, k, c.x(), in.head.linear());
+        const Vec3f d = p[v].head<3>() - fr.origin;
+        const double a = d.dot(fr.e1), b = d.dot(fr.e2);
+        const double ra = fr.rest_radius * (a >= 0 ? fr.scale_a[0] : fr.scale_a[1]);
+        const double rb = fr.rest_radius * (b >= 0 ? fr.scale_b[0] : fr.scale_b[1]);
+        worst = std::max(worst, (a / ra) * (a / ra) + (b / rb) * (b / rb));
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000u);
+  EXPECT_LE(worst, 1.0 + 1e-4);
+}
+
+// §3.4: the strands are a function of the wisp state ("reset the seed ... providing the
+// necessary coherence"): rebuilding twice, or in another model given the same state,
+// gives the same bits.
+TEST(PlanteWisp, RebuildIsDeterministic) {
+  const Scenario sc = builtin("shake", 8);
+  plante::PlanteWispModel a(ModelContext{nullptr}), b(ModelContext{nullptr});
+  a.reset(sc.groom, plante_params(sc.groom));
+  b.reset(sc.groom, plante_params(sc.groom));
+  StageTimes times;
+  FrameInput in;
+  for (int f = 0; f < 30; ++f) a.step(in = frame_input(sc, f), times);
+  const std::vector<Vec4f> first(a.positions().begin(), a.positions().end());
+  EXPECT_GT(metrics::deviation(first, sc.groom.positions, 1.0), 1e-3) << "the hair should have moved";
+  a.rebuild(in.head);
+  b.wisps() = a.wisps();
+  b.rebuild(in.head);
+  EXPECT_EQ(metrics::state_hash(first), metrics::state_hash(a.positions()));
+  EXPECT_EQ(metrics::state_hash(first), metrics::state_hash(b.positions()));
+}
+
+// After the head stops, the hair settles back towards its rest shape: the bending
+// springs target the rest directions (§3.2) and every interaction dissipates. The bound:
+// once settled, the rest-shape error on `shake` is within 0.03 L-bar of what gravity
+// alone leaves on `idle` (the wisps sag: the skeleton has only bending springs to hold
+// the style), and below half its peak during the shake.
+TEST(PlanteWisp, ReturnsTowardRestShapeAfterHeadStops) {
+  // One strand per wisp: the thinned groom's strands are 8 times sparser, and wisps of
+  // three of them would be as wide as whole locks of the full groom.
+  const std::vector<ParamOverride> thin = {{"plante_wisp", "strands_per_wisp", 1}};
+  const auto shake = test::run(builtin("shake", 8), {"plante_wisp"}, thin);
+  const auto idle = test::run(builtin("idle", 8), {"plante_wisp"}, thin, 2, 240);
+  const RunRecord& r = test::find(shake, "plante_wisp");
+  const RunRecord& i = test::find(idle, "plante_wisp");
+  ASSERT_FALSE(r.failure);
+  ASSERT_FALSE(i.failure);
+  EXPECT_LT(r.rest_shape_error.back(), i.rest_shape_error.back() + 0.03);
+  EXPECT_LT(r.rest_shape_error.back(), 0.5 * test::max_of(r.rest_shape_error));
+}
+
+// Every shipped scenario runs without NaN or blow-up of the simulation itself: finite
+// positions, skeleton segments within 50% of their rest length (thinned groom, first
+// 60 frames). Known difference: on `ponytail` the rebuilt strands - not the skeleton -
+// exceed the harness's 50% edge-length criterion (hairbench compare reports the model
+// unstable there): its front and top strands turn flat onto the scalp within 1.2 cm, the
+// wisps lying on the head get their lower envelope masses squashed to the 25% floor,
+// and a strand interpolated between a squashed and an unsquashed section is stretched
+// (max strand edge error 0.52-0.67 over the run while the skeleton strain stays < 5%).
+TEST(PlanteWisp, NoNaNOnEveryBuiltinScenario) {
+  for (const auto& file : builtin_scenarios()) {
+    const Scenario sc = builtin(file.stem().string(), 16);
+    plante::PlanteWispModel m(ModelContext{nullptr});
+    m.reset(sc.groom, plante_params(sc.groom));
+    StageTimes times;
+    double strain = 0.0;
+    bool finite = true;
+    for (int f = 0; f < 60; ++f) {
+      m.step(frame_input(sc, f), times);
+      for (const Vec4f& p : m.positions()) finite = finite && p.allFinite();
+      const auto& s = m.wisps();
+      for (std::size_t k = 1; k < s.node_count(); ++k)
+        if (s.rest_len[k] > 0.0f) strain = std::max(strain, std::abs((s.x[k] - s.x[k - 1]).norm() / s.rest_len[k] - 1.0));
+    }
+    EXPECT_TRUE(finite) << file;
+    EXPECT_LT(strain, 0.5) << file;
+  }
+}
+
+// Same input -> bit-identical state on every run and thread count (contacts are found
+// per segment range and concatenated in range order; responses are applied serially).
+TEST(PlanteWisp, DeterministicAcrossRunsAndThreads) {
+  const Scenario sc = builtin("shake", 8);
+  const std::vector<ParamOverride> parallel = {{"plante_wisp", "threads_min_wisps", 1}};
+  const auto a = test::run(sc, {"plante_wisp"}, parallel, 2, 60);
+  const auto b = test::run(sc, {"plante_wisp"}, parallel, 2, 60);
+  const auto c = test::run(sc, {"plante_wisp"}, parallel, 1, 60);
+  EXPECT_EQ(a[0].state_hash, b[0].state_hash);
+  EXPECT_EQ(a[0].state_hash, c[0].state_hash);
+}
+
+}  // namespace
+}  // namespace hairbench
