@@ -101,12 +101,12 @@ KnobSpec parse_knob(const std::string& arg) {
 // others), and every value must be valid for each of them.
 void select_knob_models(CompareArgs& a) {
   const KnobSpec& k = *a.knob;
-  std::vector<std::string> kept;
+  std::vector<std::string> kept, left_out;
   for (const std::string& name : a.run.models) {
     const ModelInfo& m = *find_model(name);
     ParamSet probe(m.params, 0);
     if (!probe.has(k.name)) {
-      std::fprintf(stderr, "hairbench: sweep: %s has no parameter '%s': left out\n", name.c_str(), k.name.c_str());
+      left_out.push_back(name);
       continue;
     }
     for (double v : k.values) probe.set(k.name, v, {"--knob", name + "."});
@@ -114,6 +114,8 @@ void select_knob_models(CompareArgs& a) {
   }
   if (kept.empty())
     throw InputError("--knob", k.name, "no model selected by --models '" + a.models + "' has this parameter");
+  for (const std::string& name : left_out)
+    std::fprintf(stderr, "hairbench: sweep: %s has no parameter '%s': left out\n", name.c_str(), k.name.c_str());
   a.run.models = std::move(kept);
 }
 
