@@ -179,6 +179,28 @@ double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> 
 
 }  // namespace
 
+std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
+                                      ThreadPool& pool) {
+  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool});
+  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
+  if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow);
+  m->reset(sc.groom, params);
+  return m;
+}
+
+FrameInput frame_input(const Scenario& sc, int f) {
+  FrameInput in;
+  in.frame = f;
+  in.dt = sc.dt;
+  in.t = (f + 1) * sc.dt;
+  in.head_prev = sc.head.at(f * sc.dt);
+  in.head = sc.head.at(in.t);
+  in.gravity = sc.gravity;
+  in.wind = sc.wind.at(in.t);
+  in.colliders = sc.colliders;
+  return in;
+}
+
 std::vector<ParamOverride> converged_reference_overrides() {
   return {{"han_m1", "local_iterations", 32}, {"han_m1", "length_iterations", 32}, {"han_m1", "substeps", 4}};
 }
@@ -202,11 +224,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   // of its model when that run's parameters are the same.
   std::vector<Lane> lanes;
   auto add_lane = [&](const ModelInfo* info, const ParamSet& params, bool reported) {
-    Lane lane{info, nullptr, {}, reported};
-    lane.model = info->make(ModelContext{&pool});
-    // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
-    if (sc.follow) lane.model = std::make_unique<FollowHairsAdapter>(std::move(lane.model), sc.guides, *sc.follow);
-    lane.model->reset(sc.groom, params);
+    Lane lane{info, make_model(*info, sc, params, pool), {}, reported};
     RunRecord& r = lane.record;
     r.scenario = sc.name;
     r.model = std::string(info->name);
@@ -252,15 +270,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   ScenarioRecord::SnapshotFrame violent_frame, final_frame;
 
   for (int f = 0; f < frames; ++f) {
-    FrameInput in;
-    in.frame = f;
-    in.dt = sc.dt;
-    in.t = (f + 1) * sc.dt;
-    in.head_prev = sc.head.at(f * sc.dt);
-    in.head = sc.head.at(in.t);
-    in.gravity = sc.gravity;
-    in.wind = sc.wind.at(in.t);
-    in.colliders = sc.colliders;
+    const FrameInput in = frame_input(sc, f);
     spheres.clear();
     for (const Sphere& c : sc.colliders) {
       const Vec3f center = collider_center(c, in.head);

@@ -9,6 +9,7 @@
 #include "scenarios/scenario.h"
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,6 +53,13 @@ struct RunOptions {
   // the reference's snapshots.
   ScenarioRecord* scenario_record = nullptr;
 };
+
+// A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides
+// when the scenario asks for it, and reset to the groom with `params`.
+std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
+                                      ThreadPool& pool);
+// The input of frame f: the head script evaluated at both ends of the step.
+FrameInput frame_input(const Scenario& sc, int f);
 
 // The reference setting `--reference converged`: han_m1 iterated far past its defaults,
 // so that every model's deviation from it is an absolute error (method 1's included).
