@@ -356,27 +356,27 @@ def chart_strands(report, out_dir, stem, written):
         columns = [(run_label(r), {s["label"]: s for s in r.get("snapshots", [])}) for r in runs]
         # The reference is shown too when it is not one of the runs (another setting).
         if not any(r["model"] == ref["model"] and not r["metrics"]["deviation_vs_reference"]["max"] for r in runs):
-            columns.insert(0, (f"reference {reference_text(runs[0])}", ref_by_label))
+            columns.insert(0, ("reference " + reference_text(runs[0]).replace(" (", "\n(").replace(", ", ",\n", 1),
+                               ref_by_label))
         frames = snaps["frames"]
         lbar = info["mean_strand_length"]
-        extent = info.get("head_radius", 0.1) + 1.1 * lbar
         fig, axes = plt.subplots(len(frames), len(columns), figsize=(2.5 * len(columns) + 1.0, 2.7 * len(frames)),
                                  squeeze=False)
         vmax = 0.0
         collections = []
+        r_head = info.get("head_radius", 0.1)
+        box = [-r_head, -r_head, r_head, r_head]  # the view: head and every strand, same in all panels
         for fi, frame in enumerate(frames):
             centre = frame["head"]["translation"]
             ref_snap = ref_by_label.get(frame["label"])
             for ci, (label, by_label) in enumerate(columns):
                 ax = axes[fi][ci]
                 ax.set_aspect("equal")
-                ax.set_xlim(-extent, extent)
-                ax.set_ylim(-extent * 1.35, extent * 0.65)
                 ax.set_xticks([])
                 ax.set_yticks([])
-                ax.add_patch(Circle((0, 0), info.get("head_radius", 0.1), color="0.85", zorder=0))
+                ax.add_patch(Circle((0, 0), r_head, color="0.85", zorder=0))
                 if fi == 0:
-                    ax.set_title(label, fontsize=8)
+                    ax.set_title(label, fontsize=7)
                 if ci == 0:
                     ax.set_ylabel(f"{frame['label'].replace('_', ' ')}\nframe {frame['frame']}, t={frame['t']:.2f} s",
                                   fontsize=8)
@@ -394,21 +394,32 @@ def chart_strands(report, out_dir, stem, written):
                     for v in range(len(xy) - 1):
                         segs.append([xy[v], xy[v + 1]])
                         devs.append(0.5 * (d[v] + d[v + 1]))
+                for seg in segs:
+                    for x, y in seg:
+                        if math.isfinite(x) and math.isfinite(y):
+                            box = [min(box[0], x), min(box[1], y), max(box[2], x), max(box[3], y)]
                 finite = [x for x in devs if math.isfinite(x)]
                 vmax = max([vmax] + finite)
                 lc = LineCollection(segs, cmap="viridis", linewidths=0.7)
                 lc.set_array(devs)
                 ax.add_collection(lc)
                 collections.append((lc, len(snap["strands"])))
+        # A blown-up run must not shrink everyone else's picture: at most 3 L-bar around the head.
+        lim = r_head + 3.0 * lbar
+        box = [max(box[0], -lim), max(box[1], -lim), min(box[2], lim), min(box[3], lim)]
+        pad = 0.05 * max(box[2] - box[0], box[3] - box[1])
+        for ax in (a for row in axes for a in row):
+            ax.set_xlim(box[0] - pad, box[2] + pad)
+            ax.set_ylim(box[1] - pad, box[3] + pad)
         drawn = [c for c in collections if c]
         vmax = vmax if vmax > 0 else 1e-6
         for lc, _ in drawn:
             lc.set_clim(0.0, vmax)
         if drawn:
             cb = fig.colorbar(drawn[0][0], ax=[a for row in axes for a in row], shrink=0.8, pad=0.01)
-            cb.set_label(f"|p − p_ref| / L̄  (reference {reference_text(runs[0])})", fontsize=8)
-        fig.suptitle(f"{name}: strands ({len(snaps['strands'])} of the groom) coloured by deviation from the "
-                     f"reference", fontsize=10)
+            cb.set_label("per-vertex deviation |p − p_ref| / L̄", fontsize=8)
+        fig.suptitle(f"{name}: {len(snaps['strands'])} strands of the groom, coloured by deviation from the "
+                     f"reference ({reference_text(runs[0])})", fontsize=10)
         files = save(fig, out_dir, stem, f"strands_{name}", written)
         out.append({"scenario": name, "files": files, "frames": [f["label"] for f in frames],
                     "columns": [c[0] for c in columns], "panels": len(collections),
