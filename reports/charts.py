@@ -196,7 +196,7 @@ def chart_time_vs_error(report, out_dir, stem, written):
             fy = [t for t, _, _ in front]
             ax.step(fx, fy, where="post", color="black", lw=1, ls="--", alpha=0.6)
             ax.scatter(fx, fy, s=110, facecolors="none", edgecolors="black", lw=1.3, label="Pareto front", zorder=5)
-        if positive:
+        if positive and any(e == 0 for _, e, _ in stable):
             ax.axvline(floor, color="grey", lw=0.6, ls=":")
         ax.set_xscale("log")
         ax.set_yscale("log")
