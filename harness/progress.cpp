@@ -45,7 +45,8 @@ void Progress::draw(double fraction_of_batch) {
   const double elapsed = std::chrono::duration<double>(last_draw_ - start_).count();
   // Runs of one batch finish together; count the batch's share by frames stepped.
   const double done = done_ + batch_ * fraction_of_batch;
-  const std::string left = done > 0.0 ? "~" + clock(elapsed * (total_ - done) / done) : std::string("?");
+  std::string left = "?";
+  if (done > 0.0) left = std::string("~").append(clock(elapsed * (total_ - done) / done));
   std::fprintf(stderr, "\r\033[Kruns %d/%d done · %s · %3.0f%% · elapsed %s · left %s", done_, total_, what_.c_str(),
                100.0 * fraction_of_batch, clock(elapsed).c_str(), left.c_str());
   std::fflush(stderr);
