@@ -1,14 +1,18 @@
 // hairbench command line (DESIGN.md, "CLI (contract)").
 #include "core/error.h"
 #include "core/parallel.h"
+#include "harness/charts.h"
+#include "harness/progress.h"
 #include "harness/runner.h"
 #include "models/registry.h"
 #include "reports/report.h"
 #include "scenarios/scenario.h"
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <regex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -18,22 +22,38 @@ namespace {
 
 constexpr const char* kUsage = R"(usage:
   hairbench list models|scenarios
-  hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL]
-                    [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR]
+  hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL|converged]
+                    [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR] [--no-charts]
+  hairbench sweep --scenario NAME|PATH [--scenario ...] --knob NAME=V1,V2,... [--models REGEX]
+                  [--reference MODEL|converged] [--frames N] [--threads N] [--set MODEL.NAME=VALUE]...
+                  [--out DIR] [--no-charts]
 
 compare runs every selected model in lockstep on each scenario (default: every built-in
-scenario) and writes DIR/report.json (default DIR: reports/out/latest).
+scenario) and writes DIR/report.json (default DIR: reports/out/latest), then its charts,
+DIR/report_summary.md and DIR/report.html.
+sweep runs every selected model that has parameter NAME at each value, and writes one
+report whose runs carry the value as "knob" (default DIR: reports/out/sweep).
   --models REGEX     models whose whole name matches (default: all)
-  --reference MODEL  deviation is measured against MODEL (default: the scenario's, han_m1)
+  --reference MODEL  deviation is measured against MODEL (default: the scenario's, han_m1);
+                     converged: han_m1 with 32 local and length iterations and 4 substeps
   --set M.NAME=V     parameter override; M may be * for every model that has NAME
-exit codes: 0 done (unstable models are results, not errors), 2 bad arguments or files)";
+  --no-charts        write the report only
+exit codes: 0 done (unstable models are results, not errors), 1 internal error or chart
+script failure, 2 bad arguments or files)";
+
+struct KnobSpec {
+  std::string name;
+  std::vector<double> values;
+};
 
 struct CompareArgs {
   std::vector<std::string> scenarios;
   std::string models = ".*";
   RunOptions run;
   int threads = 0;
-  std::string out = "reports/out/latest";
+  std::string out;
+  bool charts = true;
+  std::optional<KnobSpec> knob;  // sweep only
 };
 
 int parse_int(const std::string& flag, const std::string& v, int lo, int hi) {
@@ -50,8 +70,58 @@ int parse_int(const std::string& flag, const std::string& v, int lo, int hi) {
   return static_cast<int>(x);
 }
 
-CompareArgs parse_compare(const std::vector<std::string>& args) {
+// --knob NAME=V1,V2,...: a parameter name and distinct finite numbers.
+KnobSpec parse_knob(const std::string& arg) {
+  const auto eq = arg.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == arg.size())
+    throw InputError("--knob", arg, "expected NAME=V1,V2,... (e.g. local_iterations=1,2,4,8)");
+  KnobSpec k{arg.substr(0, eq), {}};
+  std::size_t pos = eq + 1;
+  while (pos <= arg.size()) {
+    const std::size_t comma = std::min(arg.find(',', pos), arg.size());
+    const std::string v = arg.substr(pos, comma - pos);
+    std::size_t used = 0;
+    double x = 0.0;
+    try {
+      x = std::stod(v, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != v.size()) throw InputError("--knob", arg, "'" + v + "' is not a number");
+    if (!std::isfinite(x)) throw InputError("--knob", arg, "value is NaN or infinite");
+    for (double seen : k.values)
+      if (seen == x) throw InputError("--knob", arg, "value '" + v + "' is given twice");
+    k.values.push_back(x);
+    pos = comma + 1;
+  }
+  return k;
+}
+
+// A sweep runs the selected models that have the knob's parameter (a note names the
+// others), and every value must be valid for each of them.
+void select_knob_models(CompareArgs& a) {
+  const KnobSpec& k = *a.knob;
+  std::vector<std::string> kept, left_out;
+  for (const std::string& name : a.run.models) {
+    const ModelInfo& m = *find_model(name);
+    ParamSet probe(m.params, 0);
+    if (!probe.has(k.name)) {
+      left_out.push_back(name);
+      continue;
+    }
+    for (double v : k.values) probe.set(k.name, v, {"--knob", name + "."});
+    kept.push_back(name);
+  }
+  if (kept.empty())
+    throw InputError("--knob", k.name, "no model selected by --models '" + a.models + "' has this parameter");
+  for (const std::string& name : left_out)
+    std::fprintf(stderr, "hairbench: sweep: %s has no parameter '%s': left out\n", name.c_str(), k.name.c_str());
+  a.run.models = std::move(kept);
+}
+
+CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
   CompareArgs a;
+  a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& flag = args[i];
     auto value = [&]() -> const std::string& {
@@ -68,8 +138,14 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
       check_param_override(o);
       a.run.overrides.push_back(o);
     } else if (flag == "--out") a.out = value();
-    else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
+    else if (flag == "--no-charts") a.charts = false;
+    else if (sweep && flag == "--knob") {
+      if (a.knob) throw InputError("arguments", flag, "give one --knob per sweep");
+      a.knob = parse_knob(value());
+    } else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
   }
+  if (sweep && a.scenarios.empty()) throw InputError("arguments", "sweep", "needs --scenario NAME|PATH");
+  if (sweep && !a.knob) throw InputError("arguments", "sweep", "needs --knob NAME=V1,V2,...");
   std::regex re;
   try {
     re = std::regex(a.models);
@@ -79,8 +155,13 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
   for (const ModelInfo& m : model_registry())
     if (std::regex_match(std::string(m.name), re)) a.run.models.emplace_back(m.name);
   if (a.run.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model");
-  if (!a.run.reference.empty() && !find_model(a.run.reference))
-    throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "'");
+  if (a.run.reference == kConvergedReference) {
+    a.run.reference = "han_m1";
+    a.run.reference_overrides = converged_reference_overrides();
+  } else if (!a.run.reference.empty() && !find_model(a.run.reference)) {
+    throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "' (or 'converged')");
+  }
+  if (a.knob) select_knob_models(a);
   return a;
 }
 
@@ -92,6 +173,12 @@ std::vector<Scenario> load_builtin(FILE* note) {
 }
 
 void print_run(const nlohmann::json& r) {
+  std::string label = r["model"].get<std::string>();
+  if (r.contains("knob")) {
+    char value[32];
+    std::snprintf(value, sizeof value, "=%g", r["knob"]["value"].get<double>());
+    label += " " + r["knob"]["name"].get<std::string>() + value;
+  }
   auto f = [](const nlohmann::json& v, const char* fmt) {
     char buf[32];
     if (v.is_null()) return std::string("-");
@@ -99,8 +186,7 @@ void print_run(const nlohmann::json& r) {
     return std::string(buf);
   };
   const auto& m = r["metrics"];
-  std::printf("  %-14s %-8s %9s ms %8s ns/v  dev %-9s jag %-9s len %-9s rest %-9s\n",
-              r["model"].get<std::string>().c_str(), r["status"].get<std::string>().c_str(),
+  std::printf("  %-14s %-8s %9s ms %8s ns/v  dev %-9s jag %-9s len %-9s rest %-9s\n", label.c_str(), r["status"].get<std::string>().c_str(),
               f(r["timing"]["step_ms"]["median"], "%.3f").c_str(), f(r["timing"]["ns_per_vertex"], "%.1f").c_str(),
               f(m["deviation_vs_reference"]["rms"], "%.3g").c_str(), f(m["jaggedness"]["mean"], "%.3g").c_str(),
               f(m["length_error"]["rms"], "%.2g").c_str(), f(m["rest_shape_error"], "%.3g").c_str());
@@ -109,29 +195,89 @@ void print_run(const nlohmann::json& r) {
                 r["failure"]["reason"].get<std::string>().c_str());
 }
 
-int cmd_compare(const std::vector<std::string>& args) {
-  CompareArgs a = parse_compare(args);
+// The report, then the chart step (reports/charts.py) unless --no-charts.
+int write_report(const CompareArgs& a, const ThreadPool& pool, const std::vector<RunRecord>& runs,
+                 const std::vector<ScenarioRecord>& scenarios, const nlohmann::json& sweep) {
+  const std::filesystem::path out = std::filesystem::path(a.out) / "report.json";
+  nlohmann::json report = make_report(ReportContext{pool.threads()}, runs, scenarios);
+  if (!sweep.is_null()) report["sweep"] = sweep;
+  write_json(out, report);
+  std::printf("wrote %s\n", out.string().c_str());
+  return a.charts ? draw_charts(out) : 0;
+}
+
+std::vector<Scenario> load_scenarios(const CompareArgs& a) {
   // Load every scenario before running any, so a bad file fails fast. Built-in
   // scenarios whose asset is missing are skipped with a message; named ones are errors.
   std::vector<Scenario> scenarios;
   if (a.scenarios.empty()) scenarios = load_builtin(stderr);
   for (const std::string& s : a.scenarios) scenarios.push_back(load_scenario(find_scenario(s)));
+  return scenarios;
+}
+
+void print_header(const Scenario& sc, const CompareArgs& a) {
+  std::printf("%s: %zu strands, %zu vertices, %d frames\n", sc.name.c_str(), sc.groom.strand_count(),
+              sc.groom.vertex_count(), a.run.frames > 0 ? a.run.frames : sc.frames);
+}
+
+int cmd_compare(const std::vector<std::string>& args) {
+  CompareArgs a = parse_compare(args, false);
+  const std::vector<Scenario> scenarios = load_scenarios(a);
 
   ThreadPool pool(a.threads);
+  Progress progress(static_cast<int>(scenarios.size() * a.run.models.size()), true);
   std::vector<RunRecord> runs;
+  std::vector<ScenarioRecord> records;
   for (const Scenario& sc : scenarios) {
-    std::printf("%s: %zu strands, %zu vertices, %d frames\n", sc.name.c_str(), sc.groom.strand_count(),
-                sc.groom.vertex_count(), a.run.frames > 0 ? a.run.frames : sc.frames);
+    print_header(sc, a);
     std::fflush(stdout);
-    std::vector<RunRecord> got = run_scenario(sc, a.run, pool);
+    RunOptions opt = a.run;
+    opt.scenario_record = &records.emplace_back();
+    opt.on_frame = [&](int done, int frames) { progress.frame(done, frames); };
+    progress.begin(static_cast<int>(a.run.models.size()), sc.name);
+    std::vector<RunRecord> got = run_scenario(sc, opt, pool);
+    progress.end();
     for (const RunRecord& r : got) print_run(run_json(r));
     std::fflush(stdout);
     for (RunRecord& r : got) runs.push_back(std::move(r));
   }
-  const std::filesystem::path out = std::filesystem::path(a.out) / "report.json";
-  write_json(out, make_report(ReportContext{pool.threads()}, runs));
-  std::printf("wrote %s\n", out.string().c_str());
-  return 0;
+  return write_report(a, pool, runs, records, nullptr);
+}
+
+// Every selected model at every knob value, one lockstep batch per value: the reference
+// (at the scenario's parameters, or converged) is the same in every batch.
+int cmd_sweep(const std::vector<std::string>& args) {
+  CompareArgs a = parse_compare(args, true);
+  const KnobSpec& knob = *a.knob;
+  const std::vector<Scenario> scenarios = load_scenarios(a);
+
+  ThreadPool pool(a.threads);
+  const int per_batch = static_cast<int>(a.run.models.size());
+  Progress progress(static_cast<int>(scenarios.size() * knob.values.size()) * per_batch, true);
+  std::vector<RunRecord> runs;
+  std::vector<ScenarioRecord> records;
+  for (const Scenario& sc : scenarios) {
+    print_header(sc, a);
+    std::fflush(stdout);
+    for (std::size_t k = 0; k < knob.values.size(); ++k) {
+      const double value = knob.values[k];
+      RunOptions opt = a.run;
+      for (const std::string& m : a.run.models) opt.model_overrides.push_back({m, knob.name, value});
+      opt.knob = RunRecord::Knob{knob.name, value};
+      if (k == 0) opt.scenario_record = &records.emplace_back();
+      opt.on_frame = [&](int done, int frames) { progress.frame(done, frames); };
+      char what[160];
+      std::snprintf(what, sizeof what, "%s %s=%g", sc.name.c_str(), knob.name.c_str(), value);
+      progress.begin(per_batch, what);
+      std::vector<RunRecord> got = run_scenario(sc, opt, pool);
+      progress.end();
+      for (const RunRecord& r : got) print_run(run_json(r));
+      std::fflush(stdout);
+      for (RunRecord& r : got) runs.push_back(std::move(r));
+    }
+  }
+  const nlohmann::json sweep = {{"knob", knob.name}, {"values", knob.values}, {"models", a.run.models}};
+  return write_report(a, pool, runs, records, sweep);
 }
 
 int cmd_list(const std::vector<std::string>& args) {
@@ -158,6 +304,7 @@ int run(int argc, char** argv) {
   const std::string cmd = args[0];
   args.erase(args.begin());
   if (cmd == "compare") return cmd_compare(args);
+  if (cmd == "sweep") return cmd_sweep(args);
   if (cmd == "list") return cmd_list(args);
   throw InputError("arguments", cmd, "unknown command (see hairbench --help)");
 }

@@ -4,7 +4,9 @@
 #include "core/parallel.h"
 #include "harness/follow_adapter.h"
 #include "reports/metrics.h"
+#include "scenarios/phases.h"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <cmath>
@@ -141,22 +143,88 @@ struct Lane {
   bool running = true;
 };
 
+bool same_params(const ParamSet& a, const ParamSet& b) { return a.base() == b.base() && a.regions() == b.regions(); }
+
+std::vector<ParamOverride> concat(std::vector<ParamOverride> a, const std::vector<ParamOverride>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Copies the snapshot strands' positions (xyz) out of a model's state.
+void take_snapshot(const Groom& g, std::span<const std::uint32_t> strands, std::span<const Vec4f> p,
+                   RunRecord::Snapshot& out, int frame) {
+  out.frame = frame;
+  out.strands.resize(strands.size());
+  for (std::size_t i = 0; i < strands.size(); ++i) {
+    auto& xyz = out.strands[i];
+    xyz.clear();
+    for (std::uint32_t v = g.strand_begin(strands[i]); v < g.strand_begin(strands[i]) + g.strand_size(strands[i]); ++v)
+      xyz.insert(xyz.end(), {p[v].x(), p[v].y(), p[v].z()});
+  }
+}
+
+// Kinetic energy per unit mass of the hair relative to the head between two frames:
+// mean over vertices of |p - H H_prev^-1 p_prev|^2 / (2 dt^2). Hair carried rigidly by
+// the head scores 0, so a walk's steady translation is not "violent"; a whip is.
+double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, const Affine3f& head,
+                               const Affine3f& head_prev, double dt) {
+  const Affine3f carry = head * head_prev.inverse();
+  double sum = 0.0;
+  for (std::size_t v = 0; v < p.size(); ++v) {
+    const Vec3f d = p[v].head<3>() - carry * Vec3f(prev[v].head<3>());
+    sum += static_cast<double>(d.squaredNorm());
+  }
+  return p.empty() ? 0.0 : sum / (2.0 * dt * dt * static_cast<double>(p.size()));
+}
+
 }  // namespace
+
+std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
+                                      ThreadPool& pool) {
+  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool});
+  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
+  if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow);
+  m->reset(sc.groom, params);
+  return m;
+}
+
+FrameInput frame_input(const Scenario& sc, int f) {
+  FrameInput in;
+  in.frame = f;
+  in.dt = sc.dt;
+  in.t = (f + 1) * sc.dt;
+  in.head_prev = sc.head.at(f * sc.dt);
+  in.head = sc.head.at(in.t);
+  in.gravity = sc.gravity;
+  in.wind = sc.wind.at(in.t);
+  in.colliders = sc.colliders;
+  return in;
+}
+
+std::vector<ParamOverride> converged_reference_overrides() {
+  return {{"han_m1", "local_iterations", 32}, {"han_m1", "length_iterations", 32}, {"han_m1", "substeps", 4}};
+}
+
+std::vector<std::uint32_t> snapshot_strands(const Groom& groom) {
+  const std::size_t n = groom.strand_count();
+  const std::size_t every = std::max<std::size_t>(1, (n + kMaxSnapshotStrands - 1) / kMaxSnapshotStrands);
+  std::vector<std::uint32_t> out;
+  for (std::size_t s = 0; s < n; s += every) out.push_back(static_cast<std::uint32_t>(s));
+  return out;
+}
 
 std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, ThreadPool& pool) {
   const std::string reference = opt.reference.empty() ? sc.reference : opt.reference;
   const ModelInfo* ref_info = find_model(reference);
   if (!ref_info) throw InputError(sc.source.string(), "reference", "unknown model '" + reference + "'");
+  std::map<std::string, double> ref_overrides;
+  for (const ParamOverride& o : opt.reference_overrides) ref_overrides[o.name] = o.value;
 
-  // The reference runs once per scenario: it is lane 0, reported only if selected.
+  // The reference runs once per scenario: it is lane 0, and it is also the reported run
+  // of its model when that run's parameters are the same.
   std::vector<Lane> lanes;
-  auto add_lane = [&](const ModelInfo* info, bool reported) {
-    Lane lane{info, nullptr, {}, reported};
-    const ParamSet params = resolve_params(*info, sc, opt.overrides);
-    lane.model = info->make(ModelContext{&pool});
-    // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
-    if (sc.follow) lane.model = std::make_unique<FollowHairsAdapter>(std::move(lane.model), sc.guides, *sc.follow);
-    lane.model->reset(sc.groom, params);
+  auto add_lane = [&](const ModelInfo* info, const ParamSet& params, bool reported) {
+    Lane lane{info, make_model(*info, sc, params, pool), {}, reported};
     RunRecord& r = lane.record;
     r.scenario = sc.name;
     r.model = std::string(info->name);
@@ -166,34 +234,43 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     r.settle_from = sc.settle_from;
     r.params = params_json(params, sc.groom);
     r.reference = reference;
+    r.reference_overrides = ref_overrides;
+    if (reported) r.knob = opt.knob;
+    r.snapshots = {{"most_violent", -1, {}}, {"final", -1, {}}};
     lanes.push_back(std::move(lane));
   };
-  bool ref_selected = false;
-  for (const std::string& m : opt.models) ref_selected |= (m == reference);
-  add_lane(ref_info, ref_selected);
+  const ParamSet ref_params = resolve_params(*ref_info, sc, concat(opt.overrides, opt.reference_overrides));
+  add_lane(ref_info, ref_params, false);
   for (const std::string& m : opt.models) {
-    if (m == reference) continue;
     const ModelInfo* info = find_model(m);
     if (!info) throw InputError("--models", m, "unknown model");
-    add_lane(info, true);
+    const ParamSet params = resolve_params(*info, sc, concat(opt.overrides, opt.model_overrides));
+    if (info == ref_info && same_params(params, ref_params)) {
+      lanes[0].reported = true;
+      lanes[0].record.knob = opt.knob;
+      continue;
+    }
+    add_lane(info, params, true);
   }
 
   const int frames = opt.frames > 0 ? opt.frames : sc.frames;
   for (Lane& l : lanes) l.record.frames = frames;
   const metrics::RestInfo rest(sc.groom, sc.follow ? sc.guides.strand_count() : sc.groom.strand_count());
+  const std::vector<std::uint32_t> snap_strands = snapshot_strands(sc.groom);
   StageTimes times;
   std::vector<Vec4f> spheres;
+  // The reference's positions at the end of the previous frame (at rest under the first
+  // frame's starting head transform before frame 0), for the violence criterion.
+  std::vector<Vec4f> ref_prev(sc.groom.positions);
+  {
+    const Affine3f h0 = sc.head.at(0.0);
+    for (Vec4f& p : ref_prev) p.head<3>() = h0 * Vec3f(p.head<3>());
+  }
+  double max_violence = -1.0;
+  ScenarioRecord::SnapshotFrame violent_frame, final_frame;
 
   for (int f = 0; f < frames; ++f) {
-    FrameInput in;
-    in.frame = f;
-    in.dt = sc.dt;
-    in.t = (f + 1) * sc.dt;
-    in.head_prev = sc.head.at(f * sc.dt);
-    in.head = sc.head.at(in.t);
-    in.gravity = sc.gravity;
-    in.wind = sc.wind.at(in.t);
-    in.colliders = sc.colliders;
+    const FrameInput in = frame_input(sc, f);
     spheres.clear();
     for (const Sphere& c : sc.colliders) {
       const Vec3f center = collider_center(c, in.head);
@@ -240,6 +317,45 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
       r.rest_shape_error.push_back(metrics::rest_shape_error(rest, p, in.head));
       r.penetration.push_back(metrics::penetration(p, spheres));
     }
+
+    // Snapshots: a new most violent frame replaces the previous one in every lane (a lane
+    // that has stopped has none there); the final frame is the last one each lane ran.
+    if (ref_ok) {
+      const auto ref_p = lanes[0].model->positions();
+      const double violence = relative_kinetic_energy(ref_p, ref_prev, in.head, in.head_prev, sc.dt);
+      std::copy(ref_p.begin(), ref_p.end(), ref_prev.begin());
+      if (violence > max_violence) {
+        max_violence = violence;
+        violent_frame = {"most_violent", f, in.t, violence, in.head};
+        for (Lane& l : lanes) {
+          if (l.running) take_snapshot(sc.groom, snap_strands, l.model->positions(), l.record.snapshots[0], f);
+          else l.record.snapshots[0] = {"most_violent", -1, {}};
+        }
+      }
+    }
+    if (f == frames - 1) {
+      final_frame = {"final", f, in.t, 0.0, in.head};
+      for (Lane& l : lanes)
+        if (l.running) take_snapshot(sc.groom, snap_strands, l.model->positions(), l.record.snapshots[1], f);
+    }
+    if (opt.on_frame) opt.on_frame(f + 1, frames);
+  }
+
+  if (opt.scenario_record) {
+    ScenarioRecord& out = *opt.scenario_record;
+    out.name = sc.name;
+    out.frames = frames;
+    out.dt = sc.dt;
+    out.mean_strand_length = rest.mean_strand_length;
+    out.head_radius = sc.groom.head_radius;
+    out.phases.clear();
+    for (const Phase& p : scenario_phases(sc, frames * sc.dt)) out.phases.push_back({p.start, p.end, p.kind, p.label});
+    out.snapshot_strands = snap_strands;
+    out.snapshot_frames.clear();
+    for (const auto& fr : {violent_frame, final_frame})
+      if (fr.frame >= 0) out.snapshot_frames.push_back(fr);
+    out.reference = reference;
+    out.reference_snapshots = lanes[0].record.snapshots;
   }
 
   std::vector<RunRecord> out;

@@ -9,6 +9,8 @@
 #include "scenarios/scenario.h"
 
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,10 +41,40 @@ struct RunOptions {
   std::string reference = "";       // empty: the scenario's reference
   int frames = 0;                   // > 0 overrides the scenario's frame count
   std::vector<ParamOverride> overrides;
+  // Applied after `overrides` to the reference only (--reference converged) ...
+  std::vector<ParamOverride> reference_overrides;
+  // ... and to the reported models only (a sweep's knob value, recorded as `knob`). A
+  // reported model shares the reference's lane only when its parameters come out equal.
+  std::vector<ParamOverride> model_overrides;
+  std::optional<RunRecord::Knob> knob;
+  // Called after every frame with (frames done, frames), for progress displays.
+  std::function<void(int, int)> on_frame;
+  // When set, filled with what the runs share: phases, snapshot frames and strands, and
+  // the reference's snapshots.
+  ScenarioRecord* scenario_record = nullptr;
 };
 
+// A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides
+// when the scenario asks for it, and reset to the groom with `params`.
+std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
+                                      ThreadPool& pool);
+// The input of frame f: the head script evaluated at both ends of the step.
+FrameInput frame_input(const Scenario& sc, int f);
+
+// The reference setting `--reference converged`: han_m1 iterated far past its defaults,
+// so that every model's deviation from it is an absolute error (method 1's included).
+inline constexpr const char* kConvergedReference = "converged";
+std::vector<ParamOverride> converged_reference_overrides();
+
+// The groom strands the strand pictures show: every k-th strand, at most
+// kMaxSnapshotStrands of them.
+std::vector<std::uint32_t> snapshot_strands(const Groom& groom);
+
 // Runs one scenario; a model that becomes unstable stops there (recorded in its
-// RunRecord) and the others go on. Throws InputError for bad parameters.
+// RunRecord) and the others go on. Every run records the scenario's two snapshot frames:
+// the most violent one, where the reference's kinetic energy per unit mass relative to
+// the head, mean |p(t) - H(t) H(t-dt)^-1 p(t-dt)|^2 / (2 dt^2), is highest (the first such
+// frame), and the final one. Throws InputError for bad parameters.
 std::vector<RunRecord> run_scenario(const Scenario& scenario, const RunOptions& options, ThreadPool& pool);
 
 }  // namespace hairbench

@@ -78,6 +78,18 @@ std::string git_sha() {
   return sha.empty() ? std::string(HAIRBENCH_GIT_SHA) : sha;
 }
 
+// Snapshot coordinates to 10 micrometres: enough for a picture and for per-vertex
+// deviation (L-bar is centimetres), and it keeps the numbers short in the JSON.
+nlohmann::json snapshot_json(const RunRecord::Snapshot& s) {
+  nlohmann::json strands = nlohmann::json::array();
+  for (const auto& xyz : s.strands) {
+    nlohmann::json a = nlohmann::json::array();
+    for (float x : xyz) a.push_back(std::isfinite(x) ? nlohmann::json(std::round(double(x) * 1e5) / 1e5) : nlohmann::json(nullptr));
+    strands.push_back(std::move(a));
+  }
+  return {{"label", s.label}, {"frame", s.frame}, {"strands", std::move(strands)}};
+}
+
 std::string utc_now() {
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm tm{};
@@ -135,12 +147,13 @@ nlohmann::json run_json(const RunRecord& r) {
   for (std::size_t f = 0; f < done; ++f)
     if (r.t[f] >= r.settle_from - 1e-9) settled.push_back(r.rest_shape_error[f]);
 
+  nlohmann::json deviation = {{"reference", r.reference},
+                               {"rms", num(rms(r.deviation))},
+                               {"max", num(finite_max(r.deviation))},
+                               {"final", num(r.deviation.empty() ? NAN : r.deviation.back())}};
+  if (!r.reference_overrides.empty()) deviation["reference_overrides"] = r.reference_overrides;
   nlohmann::json metrics = {
-      {"deviation_vs_reference",
-       {{"reference", r.reference},
-        {"rms", num(rms(r.deviation))},
-        {"max", num(finite_max(r.deviation))},
-        {"final", num(r.deviation.empty() ? NAN : r.deviation.back())}}},
+      {"deviation_vs_reference", std::move(deviation)},
       {"jaggedness", {{"mean", num(finite_mean(r.jaggedness))}, {"max", num(finite_max(r.jaggedness))}}},
       {"length_error", {{"rms", num(rms(r.length_rms))}, {"max", num(finite_max(r.length_max))}}},
       {"rest_shape_error", num(finite_mean(settled))},
@@ -150,40 +163,110 @@ nlohmann::json run_json(const RunRecord& r) {
   nlohmann::json failure = nullptr;
   if (r.failure) failure = {{"frame", r.failure->frame}, {"t", r.failure->t}, {"reason", r.failure->reason}};
 
-  return {{"scenario", r.scenario},
-          {"model", r.model},
-          {"backend", r.backend},
-          {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
-          {"frames", r.frames},
-          {"frames_run", done},
-          {"dt", r.dt},
-          {"settle_from", r.settle_from},
-          {"params", r.params},
-          {"status", r.failure ? "unstable" : "ok"},
-          {"failure", failure},
-          {"timing", timing},
-          {"metrics", metrics},
-          {"series",
-           {{"t", series(r.t)},
-            {"step_ms", series(r.step_ms)},
-            {"deviation_vs_reference", series(r.deviation)},
-            {"jaggedness", series(r.jaggedness)},
-            {"length_error_rms", series(r.length_rms)},
-            {"rest_shape_error", series(r.rest_shape_error)},
-            {"penetration", series(r.penetration)}}}};
+  nlohmann::json snapshots = nlohmann::json::array();
+  for (const auto& snap : r.snapshots) snapshots.push_back(snapshot_json(snap));
+
+  nlohmann::json out = {{"scenario", r.scenario},
+                       {"model", r.model},
+                       {"backend", r.backend},
+                       {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
+                       {"frames", r.frames},
+                       {"frames_run", done},
+                       {"dt", r.dt},
+                       {"settle_from", r.settle_from},
+                       {"params", r.params},
+                       {"status", r.failure ? "unstable" : "ok"},
+                       {"failure", failure},
+                       {"timing", timing},
+                       {"metrics", metrics},
+                       {"series",
+                        {{"t", series(r.t)},
+                         {"step_ms", series(r.step_ms)},
+                         {"deviation_vs_reference", series(r.deviation)},
+                         {"jaggedness", series(r.jaggedness)},
+                         {"length_error_rms", series(r.length_rms)},
+                         {"rest_shape_error", series(r.rest_shape_error)},
+                         {"penetration", series(r.penetration)}}},
+                       {"snapshots", std::move(snapshots)}};
+  if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
+  return out;
 }
 
-nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs) {
+nlohmann::json scenario_json(const ScenarioRecord& sc) {
+  nlohmann::json phases = nlohmann::json::array();
+  for (const auto& p : sc.phases)
+    phases.push_back({{"start", p.start}, {"end", p.end}, {"kind", p.kind}, {"label", p.label}});
+  nlohmann::json frames = nlohmann::json::array();
+  for (const auto& f : sc.snapshot_frames) {
+    nlohmann::json rot = nlohmann::json::array();
+    for (int i = 0; i < 3; ++i)
+      rot.push_back({f.head.linear()(i, 0), f.head.linear()(i, 1), f.head.linear()(i, 2)});
+    const Vec3f c = f.head.translation();
+    frames.push_back({{"label", f.label},
+                      {"frame", f.frame},
+                      {"t", f.t},
+                      {"violence", num(f.violence)},
+                      {"head", {{"translation", {c.x(), c.y(), c.z()}}, {"rotation", rot}}}});
+  }
+  nlohmann::json ref = nlohmann::json::array();
+  for (const auto& snap : sc.reference_snapshots) ref.push_back(snapshot_json(snap));
+  return {{"name", sc.name},
+          {"frames", sc.frames},
+          {"dt", sc.dt},
+          {"duration", sc.frames * sc.dt},
+          {"mean_strand_length", sc.mean_strand_length},
+          {"head_radius", sc.head_radius},
+          {"phases", std::move(phases)},
+          {"snapshots",
+           {{"criterion", "most_violent: the frame where the reference's kinetic energy per unit mass relative to "
+                          "the head, mean over vertices of |p(t) - H(t) H(t-dt)^-1 p(t-dt)|^2 / (2 dt^2), is "
+                          "highest (hair moving rigidly with the head is still); final: the last frame"},
+            {"strands", sc.snapshot_strands},
+            {"frames", std::move(frames)},
+            {"reference", {{"model", sc.reference}, {"snapshots", std::move(ref)}}}}}};
+}
+
+nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,
+                           const std::vector<ScenarioRecord>& scenarios) {
   nlohmann::json j = {{"schema", "hairbench-report"}, {"schema_version", 1}, {"context", context_json(ctx)}};
   j["runs"] = nlohmann::json::array();
   for (const RunRecord& r : runs) j["runs"].push_back(run_json(r));
+  if (!scenarios.empty()) {
+    j["scenarios"] = nlohmann::json::array();
+    for (const ScenarioRecord& sc : scenarios) j["scenarios"].push_back(scenario_json(sc));
+  }
   return j;
 }
+
+namespace {
+
+// Indented like dump(1), except that an array of numbers (a series, a snapshot strand)
+// stays on one line: the report stays readable and a tenth of the size.
+void write_pretty(std::ostream& o, const nlohmann::json& j, int depth) {
+  const bool flat_array =
+      j.is_array() && std::none_of(j.begin(), j.end(), [](const nlohmann::json& e) { return e.is_structured(); });
+  if (!j.is_structured() || j.empty() || flat_array) {
+    o << j.dump();
+    return;
+  }
+  const std::string pad(depth + 1, ' ');
+  o << (j.is_object() ? "{\n" : "[\n");
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it != j.begin()) o << ",\n";
+    o << pad;
+    if (j.is_object()) o << nlohmann::json(it.key()).dump() << ": ";
+    write_pretty(o, *it, depth + 1);
+  }
+  o << '\n' << std::string(depth, ' ') << (j.is_object() ? '}' : ']');
+}
+
+}  // namespace
 
 void write_json(const std::filesystem::path& file, const nlohmann::json& j) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   std::ofstream out(file);
-  out << j.dump(1) << '\n';
+  write_pretty(out, j, 0);
+  out << '\n';
   if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 

@@ -1,6 +1,8 @@
 // The hairbench-report JSON (DESIGN.md, "Report (contract)", schema_version 1).
 #pragma once
 
+#include "core/types.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -41,7 +43,54 @@ struct RunRecord {
   std::vector<double> t;  // time at the end of each frame
   std::map<std::string, double> stage_ms_total;  // summed over the run
   std::uint64_t state_hash = 0;
+
+  // Parameters given to the reference on top of the scenario's (--reference converged);
+  // empty when the reference runs at the scenario's parameters.
+  std::map<std::string, double> reference_overrides;
+  // The swept parameter and its value for this run (hairbench sweep); unset for compare.
+  struct Knob {
+    std::string name;
+    double value;
+  };
+  std::optional<Knob> knob;
+  // Positions of the scenario's snapshot strands at its snapshot frames (see
+  // ScenarioRecord), for strand pictures. A snapshot the run did not reach (it became
+  // unstable first) has no strands.
+  struct Snapshot {
+    std::string label;  // "most_violent" or "final"
+    int frame = -1;
+    std::vector<std::vector<float>> strands;  // per snapshot strand: x0 y0 z0 x1 y1 z1 ...
+  };
+  std::vector<Snapshot> snapshots;
 };
+
+// What the runs of one scenario share: its script phases, and the frames and strands
+// the strand pictures show, with the reference's positions there.
+struct ScenarioRecord {
+  std::string name;
+  int frames = 0;
+  double dt = 0.0;
+  double mean_strand_length = 0.0;  // L-bar, metres: per-vertex deviation is |p - p_ref| / L-bar
+  double head_radius = 0.0;
+  struct PhaseSpan {
+    double start, end;
+    std::string kind, label;
+  };
+  std::vector<PhaseSpan> phases;
+  std::vector<std::uint32_t> snapshot_strands;  // groom strand indices, at most kMaxSnapshotStrands
+  struct SnapshotFrame {
+    std::string label;
+    int frame = -1;
+    double t = 0.0;
+    double violence = 0.0;  // the criterion's value at that frame (see runner.h)
+    Affine3f head = Affine3f::Identity();
+  };
+  std::vector<SnapshotFrame> snapshot_frames;
+  std::string reference;
+  std::vector<RunRecord::Snapshot> reference_snapshots;
+};
+
+inline constexpr std::size_t kMaxSnapshotStrands = 200;
 
 struct ReportContext {
   int threads = 1;
@@ -49,7 +98,11 @@ struct ReportContext {
 
 nlohmann::json context_json(const ReportContext& ctx);
 nlohmann::json run_json(const RunRecord& run);
-nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs);
+nlohmann::json scenario_json(const ScenarioRecord& sc);
+// `scenarios` adds the report's "scenarios" list (phases, snapshot frames); a report
+// without it is still schema version 1.
+nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,
+                           const std::vector<ScenarioRecord>& scenarios = {});
 // Writes pretty JSON, creating the folder; throws std::runtime_error on I/O failure.
 void write_json(const std::filesystem::path& file, const nlohmann::json& j);
 

@@ -5,7 +5,9 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -17,8 +19,8 @@ struct Result {
   std::string out;
 };
 
-Result run_cli(const std::string& args) {
-  const std::string cmd = std::string("\"") + HAIRBENCH_EXE + "\" " + args + " 2>&1";
+Result run_cli(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + "\"" + HAIRBENCH_EXE + "\" " + args + " 2>&1";
   Result r{-1, {}};
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -111,6 +113,129 @@ TEST(Cli, CompareWritesTheReportContract) {
   EXPECT_EQ(j["runs"][1]["params"]["local_iterations"], 7);
   EXPECT_NE(j["runs"][0]["params"]["local_iterations"], 7);  // han_m1 keeps its own value
   EXPECT_EQ(j["runs"][0]["metrics"]["deviation_vs_reference"]["max"], 0.0);
+}
+
+nlohmann::json read_report(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "report.json");
+  return nlohmann::json::parse(in);
+}
+
+const std::string kTinyShake = std::string(HAIRBENCH_TEST_DATA_DIR) + "/reports/tiny_shake.json";
+
+TEST(Cli, SweepBadArgumentsExitTwo) {
+  const std::string sc = " --scenario \"" + kTinyShake + "\" --no-charts --out /tmp/hairbench-cli-sweep-bad";
+  for (const std::string args :
+       {std::string("sweep --knob local_iterations=1"), "sweep" + sc, "sweep" + sc + " --knob local_iterations=",
+        "sweep" + sc + " --knob local_iterations=1,x", "sweep" + sc + " --knob local_iterations=1,1",
+        "sweep" + sc + " --knob local_iterations=100", "sweep" + sc + " --knob nosuch=1",
+        "sweep" + sc + " --knob local_iterations=1.5", "sweep" + sc + " --knob =1",
+        "sweep" + sc + " --knob local_iterations=1 --knob substeps=2",
+        "sweep" + sc + " --knob local_iterations=1 --reference bogus",
+        "compare" + sc + " --knob local_iterations=1"}) {
+    const Result r = run_cli(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.out;
+    EXPECT_EQ(count_lines(r.out), 1) << args << ": " << r.out;
+  }
+}
+
+// Strand-snapshot deviation, recomputed from the report's positions: RMS over the
+// snapshot vertices of |p - p_ref| / L-bar.
+double snapshot_deviation(const nlohmann::json& strands, const nlohmann::json& ref, double lbar) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t s = 0; s < strands.size(); ++s)
+    for (std::size_t i = 0; i + 2 < strands[s].size(); i += 3, ++n) {
+      double d2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double d = strands[s][i + k].get<double>() - ref[s][i + k].get<double>();
+        d2 += d * d;
+      }
+      sum += d2;
+    }
+  return std::sqrt(sum / static_cast<double>(n)) / lbar;
+}
+
+// A sweep: every model at every knob value, each run carrying its value; the reference
+// is han_m1 at the scenario's parameters, so han_m1 at that value is the reference
+// itself (deviation exactly 0) and other values are not. The snapshots agree with the
+// deviation series, and the phases come from the head script.
+TEST(Cli, SweepRecordsKnobsPhasesAndSnapshots) {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-sweep";
+  std::filesystem::remove_all(out);
+  const Result r = run_cli("sweep --scenario \"" + kTinyShake +
+                           "\" --models 'han_m[12]' --knob local_iterations=1,3 --frames 30 --threads 2 --no-charts --out " +
+                           out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = read_report(out);
+  EXPECT_EQ(j["sweep"]["knob"], "local_iterations");
+  ASSERT_EQ(j["runs"].size(), 4u);
+  std::map<std::string, double> dev;
+  for (const auto& run : j["runs"]) {
+    ASSERT_TRUE(run.contains("knob"));
+    EXPECT_EQ(run["knob"]["name"], "local_iterations");
+    EXPECT_EQ(run["params"]["local_iterations"], run["knob"]["value"]);
+    dev[run["model"].get<std::string>() + "@" + run["knob"]["value"].dump()] =
+        run["metrics"]["deviation_vs_reference"]["max"].get<double>();
+  }
+  EXPECT_EQ(dev.at("han_m1@1.0"), 0.0);
+  EXPECT_GT(dev.at("han_m1@3.0"), 0.0);
+  EXPECT_GT(dev.at("han_m2@1.0"), 0.0);
+
+  ASSERT_EQ(j["scenarios"].size(), 1u);
+  const auto& sc = j["scenarios"][0];
+  ASSERT_EQ(sc["phases"].size(), 1u);  // the oscillator, 0 to 0.4 s
+  EXPECT_EQ(sc["phases"][0]["kind"], "oscillate");
+  EXPECT_NEAR(sc["phases"][0]["end"].get<double>(), 0.4, 1e-9);
+  const auto& snaps = sc["snapshots"];
+  EXPECT_EQ(snaps["strands"].size(), 24u);  // every strand of a groom under 200
+  ASSERT_EQ(snaps["frames"].size(), 2u);
+  EXPECT_EQ(snaps["frames"][0]["label"], "most_violent");
+  EXPECT_GT(snaps["frames"][0]["violence"].get<double>(), 0.0);
+  EXPECT_EQ(snaps["frames"][1]["frame"], 29);
+  const double lbar = sc["mean_strand_length"].get<double>();
+  const auto& ref = snaps["reference"]["snapshots"];
+  for (const auto& run : j["runs"]) {
+    ASSERT_EQ(run["snapshots"].size(), 2u);
+    for (int k = 0; k < 2; ++k) {
+      const int frame = snaps["frames"][k]["frame"].get<int>();
+      EXPECT_EQ(run["snapshots"][k]["frame"], frame);
+      // Positions are rounded to 10 micrometres in the report.
+      EXPECT_NEAR(snapshot_deviation(run["snapshots"][k]["strands"], ref[k]["strands"], lbar),
+                  run["series"]["deviation_vs_reference"][frame].get<double>(), 1e-4)
+          << run["model"] << " frame " << frame;
+    }
+  }
+}
+
+// --reference converged: han_m1 iterated to convergence, so method 1 at the scenario's
+// parameters has an error of its own, and the report says what the reference was.
+TEST(Cli, ConvergedReferenceMeasuresMethodOneToo) {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-converged";
+  std::filesystem::remove_all(out);
+  const Result r = run_cli("sweep --scenario \"" + kTinyShake +
+                           "\" --models han_m1 --knob local_iterations=1 --reference converged --frames 20 --no-charts --out " +
+                           out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = read_report(out);
+  ASSERT_EQ(j["runs"].size(), 1u);
+  const auto& d = j["runs"][0]["metrics"]["deviation_vs_reference"];
+  EXPECT_GT(d["max"].get<double>(), 0.0);
+  EXPECT_EQ(d["reference_overrides"]["local_iterations"], 32);
+  EXPECT_EQ(d["reference_overrides"]["length_iterations"], 32);
+  EXPECT_EQ(d["reference_overrides"]["substeps"], 4);
+}
+
+// Without a usable interpreter the report is still written, exit 0, and the CLI says
+// what to install and the command that draws the charts later.
+TEST(Cli, ChartStepSaysHowToDrawLater) {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-nocharts";
+  std::filesystem::remove_all(out);
+  const Result r = run_cli("compare --scenario \"" + kTinyShake + "\" --models han_m3 --frames 3 --out " + out.string(),
+                           "HAIRBENCH_PYTHON=/nonexistent/python3 ");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(out / "report.json"));
+  EXPECT_NE(r.out.find("python3-matplotlib"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("charts.py " + (out / "report.json").string()), std::string::npos) << r.out;
 }
 
 }  // namespace
