@@ -5,6 +5,9 @@
 #include "models/registry.h"
 #include "reports/report.h"
 #include "scenarios/scenario.h"
+#ifdef HAIRBENCH_HAS_VULKAN
+#include "kernels/vulkan/runtime.h"
+#endif
 
 #include <cstdio>
 #include <iostream>
@@ -17,20 +20,24 @@ namespace hairbench {
 namespace {
 
 constexpr const char* kUsage = R"(usage:
-  hairbench list models|scenarios
+  hairbench list models|scenarios|devices
   hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL]
                     [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR]
+                    [--device NAME|INDEX]
 
 compare runs every selected model in lockstep on each scenario (default: every built-in
 scenario) and writes DIR/report.json (default DIR: reports/out/latest).
   --models REGEX     models whose whole name matches (default: all)
   --reference MODEL  deviation is measured against MODEL (default: the scenario's, han_m1)
   --set M.NAME=V     parameter override; M may be * for every model that has NAME
+  --device D         Vulkan device of the *_vk models, by index or name (see list
+                     devices; default: the first discrete GPU, else any device)
 exit codes: 0 done (unstable models are results, not errors), 2 bad arguments or files)";
 
 struct CompareArgs {
   std::vector<std::string> scenarios;
   std::string models = ".*";
+  bool models_given = false;
   RunOptions run;
   int threads = 0;
   std::string out = "reports/out/latest";
@@ -59,7 +66,10 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
       return args[++i];
     };
     if (flag == "--scenario") a.scenarios.push_back(value());
-    else if (flag == "--models") a.models = value();
+    else if (flag == "--models") {
+      a.models = value();
+      a.models_given = true;
+    } else if (flag == "--device") a.run.device = value();
     else if (flag == "--reference") a.run.reference = value();
     else if (flag == "--frames") a.run.frames = parse_int(flag, value(), 1, 10'000'000);
     else if (flag == "--threads") a.threads = parse_int(flag, value(), 1, 1024);
@@ -76,8 +86,15 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
   } catch (const std::regex_error& e) {
     throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
   }
-  for (const ModelInfo& m : model_registry())
-    if (std::regex_match(std::string(m.name), re)) a.run.models.emplace_back(m.name);
+  // Models that need a missing device (no Vulkan): left out with a note by default, an
+  // error when --models asked for them.
+  for (const ModelInfo& m : model_registry()) {
+    if (!std::regex_match(std::string(m.name), re)) continue;
+    const std::string why = m.unavailable ? m.unavailable(ModelContext{nullptr, a.run.device}) : "";
+    if (why.empty()) a.run.models.emplace_back(m.name);
+    else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
+    else std::fprintf(stderr, "hairbench: skipped model %s: %s\n", std::string(m.name).c_str(), why.c_str());
+  }
   if (a.run.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model");
   if (!a.run.reference.empty() && !find_model(a.run.reference))
     throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "'");
@@ -135,7 +152,8 @@ int cmd_compare(const std::vector<std::string>& args) {
 }
 
 int cmd_list(const std::vector<std::string>& args) {
-  if (args.size() != 1) throw InputError("arguments", "list", "expected `list models` or `list scenarios`");
+  if (args.size() != 1)
+    throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
   if (args[0] == "models") {
     for (const ModelInfo& m : model_registry())
       std::printf("%-14s %s\n", std::string(m.name).c_str(), std::string(m.summary).c_str());
@@ -146,7 +164,20 @@ int cmd_list(const std::vector<std::string>& args) {
       std::printf("%-18s %s\n", sc.name.c_str(), sc.description.c_str());
     return 0;
   }
-  throw InputError("arguments", "list " + args[0], "expected `list models` or `list scenarios`");
+  if (args[0] == "devices") {
+#ifdef HAIRBENCH_HAS_VULKAN
+    try {
+      for (const vk::DeviceInfo& d : vk::list_devices())
+        std::printf("%u  %-40s %s\n", d.index, d.name.c_str(), d.type.c_str());
+    } catch (const vk::Unavailable& e) {
+      std::printf("%s\n", e.what());
+    }
+#else
+    std::puts("no Vulkan backend in this build (configure with libvulkan-dev and glslc)");
+#endif
+    return 0;
+  }
+  throw InputError("arguments", "list " + args[0], "expected `list models`, `list scenarios` or `list devices`");
 }
 
 int run(int argc, char** argv) {

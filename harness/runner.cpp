@@ -153,13 +153,16 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   auto add_lane = [&](const ModelInfo* info, bool reported) {
     Lane lane{info, nullptr, {}, reported};
     const ParamSet params = resolve_params(*info, sc, opt.overrides);
-    lane.model = info->make(ModelContext{&pool});
+    lane.model = info->make(ModelContext{&pool, opt.device});
     // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
     if (sc.follow) lane.model = std::make_unique<FollowHairsAdapter>(std::move(lane.model), sc.guides, *sc.follow);
     lane.model->reset(sc.groom, params);
     RunRecord& r = lane.record;
     r.scenario = sc.name;
     r.model = std::string(info->name);
+    const Backend backend = lane.model->backend();
+    r.backend = backend.name;
+    r.device = backend.device;
     r.strands = sc.groom.strand_count();
     r.vertices = sc.groom.vertex_count();
     r.dt = sc.dt;
@@ -207,6 +210,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
       l.model->step(in, times);
       const auto end = std::chrono::steady_clock::now();
       l.record.step_ms.push_back(std::chrono::duration<double, std::milli>(end - start).count());
+      if (const auto gpu = l.model->last_gpu_ms()) l.record.gpu_ms.push_back(*gpu);
       for (const auto& e : times.entries()) l.record.stage_ms_total[std::string(e.name)] += e.ms;
     }
 

@@ -39,6 +39,7 @@ struct RunOptions {
   std::string reference = "";       // empty: the scenario's reference
   int frames = 0;                   // > 0 overrides the scenario's frame count
   std::vector<ParamOverride> overrides;
+  std::string device;  // GPU models' --device (empty: the default device)
 };
 
 // Runs one scenario; a model that becomes unstable stops there (recorded in its

@@ -130,6 +130,12 @@ nlohmann::json run_json(const RunRecord& r) {
       {"stage_ms", stage},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
 
+  if (!r.gpu_ms.empty())
+    timing["gpu_ms"] = {{"mean", num(finite_mean(r.gpu_ms))},
+                        {"median", num(median(r.gpu_ms))},
+                        {"min", num(*std::min_element(r.gpu_ms.begin(), r.gpu_ms.end()))},
+                        {"p95", num(percentile(r.gpu_ms, 0.95))}};
+
   // rest_shape_error averages the frames that end at or after settle_from.
   std::vector<double> settled;
   for (std::size_t f = 0; f < done; ++f)
@@ -150,7 +156,7 @@ nlohmann::json run_json(const RunRecord& r) {
   nlohmann::json failure = nullptr;
   if (r.failure) failure = {{"frame", r.failure->frame}, {"t", r.failure->t}, {"reason", r.failure->reason}};
 
-  return {{"scenario", r.scenario},
+  nlohmann::json run = {{"scenario", r.scenario},
           {"model", r.model},
           {"backend", r.backend},
           {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
@@ -171,12 +177,19 @@ nlohmann::json run_json(const RunRecord& r) {
             {"length_error_rms", series(r.length_rms)},
             {"rest_shape_error", series(r.rest_shape_error)},
             {"penetration", series(r.penetration)}}}};
+  if (!r.device.empty()) run["device"] = r.device;
+  if (!r.gpu_ms.empty()) run["series"]["gpu_ms"] = series(r.gpu_ms);
+  return run;
 }
 
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs) {
   nlohmann::json j = {{"schema", "hairbench-report"}, {"schema_version", 1}, {"context", context_json(ctx)}};
   j["runs"] = nlohmann::json::array();
   for (const RunRecord& r : runs) j["runs"].push_back(run_json(r));
+  for (const RunRecord& r : runs)
+    if (!r.device.empty() && std::find(j["context"]["devices"].begin(), j["context"]["devices"].end(), r.device) ==
+                                 j["context"]["devices"].end())
+      j["context"]["devices"].push_back(r.device);
   return j;
 }
 
