@@ -61,6 +61,8 @@ class StageTimer {
 
 // What a model may use besides its input: the harness's worker threads.
 struct ModelContext {
+  // A constructor rather than an aggregate, so ModelContext{&pool} stays warning-free.
+  ModelContext(ThreadPool* p = nullptr, std::string d = {}) : pool(p), device(std::move(d)) {}
   ThreadPool* pool = nullptr;
   std::string device;  // GPU models: --device NAME|INDEX, empty for the default device
 };
