@@ -85,7 +85,7 @@ TEST(Cli, ListsModelsAndScenarios) {
 TEST(Cli, CompareWritesTheReportContract) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-compare";
   std::filesystem::remove_all(out);
-  const Result r = run_cli("compare --scenario shake --frames 5 --threads 2 --set han_m2.local_iterations=7 --out " +
+  const Result r = run_cli("compare --scenario shake --models 'han_m[123]' --frames 5 --threads 2 --set han_m2.local_iterations=7 --out " +
                            out.string());
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in(out / "report.json");

@@ -109,7 +109,6 @@ class Context {
   // matched case-insensitively against device names. Throws Unavailable when Vulkan or
   // any device is missing, and InputError("--device", spec, ...) when nothing matches.
   static std::shared_ptr<Context> get(const std::string& spec);
-  ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
@@ -135,7 +134,6 @@ class Context {
   std::uint32_t memory_type(std::uint32_t allowed, Memory where) const;
 
   DeviceInfo info_;
-  VkInstance instance_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
