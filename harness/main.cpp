@@ -90,7 +90,15 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
   // error when --models asked for them.
   for (const ModelInfo& m : model_registry()) {
     if (!std::regex_match(std::string(m.name), re)) continue;
-    const std::string why = m.unavailable ? m.unavailable(ModelContext{nullptr, a.run.device}) : "";
+    std::string why = m.unavailable ? m.unavailable(ModelContext{nullptr, a.run.device}) : "";
+#ifdef HAIRBENCH_HAS_VULKAN
+    // On a CPU Vulkan device (lavapipe) the GPU models take seconds per frame: run them
+    // only when --models asks for them.
+    if (why.empty() && m.unavailable && !a.models_given &&
+        vk::Context::get(a.run.device)->device().type == "CPU")
+      why = "the Vulkan device is a CPU (" + vk::Context::get(a.run.device)->device().name +
+            "); name it in --models to run it";
+#endif
     if (why.empty()) a.run.models.emplace_back(m.name);
     else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
     else std::fprintf(stderr, "hairbench: skipped model %s: %s\n", std::string(m.name).c_str(), why.c_str());
