@@ -38,6 +38,7 @@ struct CompareArgs {
   std::vector<std::string> scenarios;
   std::string models = ".*";
   bool models_given = false;
+  std::vector<std::string> skipped;  // models left out, and why (printed once the inputs are good)
   RunOptions run;
   int threads = 0;
   std::string out = "reports/out/latest";
@@ -101,7 +102,7 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
 #endif
     if (why.empty()) a.run.models.emplace_back(m.name);
     else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
-    else std::fprintf(stderr, "hairbench: skipped model %s: %s\n", std::string(m.name).c_str(), why.c_str());
+    else a.skipped.push_back(std::string(m.name) + ": " + why);
   }
   if (a.run.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model");
   if (!a.run.reference.empty() && !find_model(a.run.reference))
@@ -141,6 +142,7 @@ int cmd_compare(const std::vector<std::string>& args) {
   std::vector<Scenario> scenarios;
   if (a.scenarios.empty()) scenarios = load_builtin(stderr);
   for (const std::string& s : a.scenarios) scenarios.push_back(load_scenario(find_scenario(s)));
+  for (const std::string& why : a.skipped) std::fprintf(stderr, "hairbench: skipped model %s\n", why.c_str());
 
   ThreadPool pool(a.threads);
   std::vector<RunRecord> runs;
