@@ -7,7 +7,9 @@
 
 #include <array>
 #include <chrono>
+#include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 
 namespace hairbench {
@@ -59,7 +61,16 @@ class StageTimer {
 
 // What a model may use besides its input: the harness's worker threads.
 struct ModelContext {
+  // A constructor rather than an aggregate, so ModelContext{&pool} stays warning-free.
+  ModelContext(ThreadPool* p = nullptr, std::string d = {}) : pool(p), device(std::move(d)) {}
   ThreadPool* pool = nullptr;
+  std::string device;  // GPU models: --device NAME|INDEX, empty for the default device
+};
+
+// Where a model runs, for the report (run "backend" and "device").
+struct Backend {
+  std::string name = "cpu";
+  std::string device;  // e.g. the Vulkan device's name; empty on the CPU
 };
 
 class HairModel {
@@ -72,6 +83,10 @@ class HairModel {
   virtual void step(const FrameInput& in, StageTimes& out_times) = 0;
   // Same topology as the groom given to reset(): strand s, vertex i, world space.
   virtual std::span<const Vec4f> positions() const = 0;
+  virtual Backend backend() const { return {}; }
+  // Device time of the last step() from GPU timestamps (report timing.gpu_ms); nullopt
+  // for models that do not run on a GPU.
+  virtual std::optional<double> last_gpu_ms() const { return std::nullopt; }
 };
 
 }  // namespace hairbench

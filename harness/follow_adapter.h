@@ -23,6 +23,8 @@ class FollowHairsAdapter final : public HairModel {
   void step(const FrameInput& in, StageTimes& out_times) override;
   // The guides' positions, then the follow strands'.
   std::span<const Vec4f> positions() const override { return positions_; }
+  Backend backend() const override { return inner_->backend(); }
+  std::optional<double> last_gpu_ms() const override { return inner_->last_gpu_ms(); }
 
  private:
   void rebuild();

@@ -7,6 +7,9 @@
 #include "models/registry.h"
 #include "reports/report.h"
 #include "scenarios/scenario.h"
+#ifdef HAIRBENCH_HAS_VULKAN
+#include "kernels/vulkan/runtime.h"
+#endif
 
 #include <cmath>
 #include <cstdio>
@@ -21,9 +24,10 @@ namespace hairbench {
 namespace {
 
 constexpr const char* kUsage = R"(usage:
-  hairbench list models|scenarios
+  hairbench list models|scenarios|devices
   hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL|converged]
                     [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR] [--no-charts]
+                    [--device NAME|INDEX]
   hairbench sweep --scenario NAME|PATH [--scenario ...] --knob NAME=V1,V2,... [--models REGEX]
                   [--reference MODEL|converged] [--frames N] [--threads N] [--set MODEL.NAME=VALUE]...
                   [--out DIR] [--no-charts]
@@ -38,6 +42,8 @@ report whose runs carry the value as "knob" (default DIR: reports/out/sweep).
                      converged: han_m1 with 32 local and length iterations and 4 substeps
   --set M.NAME=V     parameter override; M may be * for every model that has NAME
   --no-charts        write the report only
+  --device D         Vulkan device of the *_vk models, by index or name (see list
+                     devices; default: the first discrete GPU, else any device)
 exit codes: 0 done (unstable models are results, not errors), 1 internal error or chart
 script failure, 2 bad arguments or files)";
 
@@ -49,6 +55,8 @@ struct KnobSpec {
 struct CompareArgs {
   std::vector<std::string> scenarios;
   std::string models = ".*";
+  bool models_given = false;
+  std::vector<std::string> skipped;  // models left out, and why (printed once the inputs are good)
   RunOptions run;
   int threads = 0;
   std::string out;
@@ -129,7 +137,10 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
       return args[++i];
     };
     if (flag == "--scenario") a.scenarios.push_back(value());
-    else if (flag == "--models") a.models = value();
+    else if (flag == "--models") {
+      a.models = value();
+      a.models_given = true;
+    } else if (flag == "--device") a.run.device = value();
     else if (flag == "--reference") a.run.reference = value();
     else if (flag == "--frames") a.run.frames = parse_int(flag, value(), 1, 10'000'000);
     else if (flag == "--threads") a.threads = parse_int(flag, value(), 1, 1024);
@@ -152,8 +163,23 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
   } catch (const std::regex_error& e) {
     throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
   }
-  for (const ModelInfo& m : model_registry())
-    if (std::regex_match(std::string(m.name), re)) a.run.models.emplace_back(m.name);
+  // Models that need a missing device (no Vulkan): left out with a note by default, an
+  // error when --models asked for them.
+  for (const ModelInfo& m : model_registry()) {
+    if (!std::regex_match(std::string(m.name), re)) continue;
+    std::string why = m.unavailable ? m.unavailable(ModelContext{nullptr, a.run.device}) : "";
+#ifdef HAIRBENCH_HAS_VULKAN
+    // On a CPU Vulkan device (lavapipe) the GPU models take seconds per frame: run them
+    // only when --models asks for them.
+    if (why.empty() && m.unavailable && !a.models_given &&
+        vk::Context::get(a.run.device)->device().type == "CPU")
+      why = "the Vulkan device is a CPU (" + vk::Context::get(a.run.device)->device().name +
+            "); name it in --models to run it";
+#endif
+    if (why.empty()) a.run.models.emplace_back(m.name);
+    else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
+    else a.skipped.push_back(std::string(m.name) + ": " + why);
+  }
   if (a.run.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model");
   if (a.run.reference == kConvergedReference) {
     a.run.reference = "han_m1";
@@ -212,6 +238,7 @@ std::vector<Scenario> load_scenarios(const CompareArgs& a) {
   std::vector<Scenario> scenarios;
   if (a.scenarios.empty()) scenarios = load_builtin(stderr);
   for (const std::string& s : a.scenarios) scenarios.push_back(load_scenario(find_scenario(s)));
+  for (const std::string& why : a.skipped) std::fprintf(stderr, "hairbench: skipped model %s\n", why.c_str());
   return scenarios;
 }
 
@@ -281,7 +308,8 @@ int cmd_sweep(const std::vector<std::string>& args) {
 }
 
 int cmd_list(const std::vector<std::string>& args) {
-  if (args.size() != 1) throw InputError("arguments", "list", "expected `list models` or `list scenarios`");
+  if (args.size() != 1)
+    throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
   if (args[0] == "models") {
     for (const ModelInfo& m : model_registry())
       std::printf("%-14s %s\n", std::string(m.name).c_str(), std::string(m.summary).c_str());
@@ -292,7 +320,20 @@ int cmd_list(const std::vector<std::string>& args) {
       std::printf("%-18s %s\n", sc.name.c_str(), sc.description.c_str());
     return 0;
   }
-  throw InputError("arguments", "list " + args[0], "expected `list models` or `list scenarios`");
+  if (args[0] == "devices") {
+#ifdef HAIRBENCH_HAS_VULKAN
+    try {
+      for (const vk::DeviceInfo& d : vk::list_devices())
+        std::printf("%u  %-40s %s\n", d.index, d.name.c_str(), d.type.c_str());
+    } catch (const vk::Unavailable& e) {
+      std::printf("%s\n", e.what());
+    }
+#else
+    std::puts("no Vulkan backend in this build (configure with libvulkan-dev and glslc)");
+#endif
+    return 0;
+  }
+  throw InputError("arguments", "list " + args[0], "expected `list models`, `list scenarios` or `list devices`");
 }
 
 int run(int argc, char** argv) {

@@ -180,8 +180,8 @@ double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> 
 }  // namespace
 
 std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
-                                      ThreadPool& pool) {
-  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool});
+                                      ThreadPool& pool, const std::string& device) {
+  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool, device});
   // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
   if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow);
   m->reset(sc.groom, params);
@@ -224,10 +224,13 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   // of its model when that run's parameters are the same.
   std::vector<Lane> lanes;
   auto add_lane = [&](const ModelInfo* info, const ParamSet& params, bool reported) {
-    Lane lane{info, make_model(*info, sc, params, pool), {}, reported};
+    Lane lane{info, make_model(*info, sc, params, pool, opt.device), {}, reported};
     RunRecord& r = lane.record;
     r.scenario = sc.name;
     r.model = std::string(info->name);
+    const Backend backend = lane.model->backend();
+    r.backend = backend.name;
+    r.device = backend.device;
     r.strands = sc.groom.strand_count();
     r.vertices = sc.groom.vertex_count();
     r.dt = sc.dt;
@@ -284,6 +287,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
       l.model->step(in, times);
       const auto end = std::chrono::steady_clock::now();
       l.record.step_ms.push_back(std::chrono::duration<double, std::milli>(end - start).count());
+      if (const auto gpu = l.model->last_gpu_ms()) l.record.gpu_ms.push_back(*gpu);
       for (const auto& e : times.entries()) l.record.stage_ms_total[std::string(e.name)] += e.ms;
     }
 

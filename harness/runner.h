@@ -52,12 +52,13 @@ struct RunOptions {
   // When set, filled with what the runs share: phases, snapshot frames and strands, and
   // the reference's snapshots.
   ScenarioRecord* scenario_record = nullptr;
+  std::string device;  // GPU models' --device (empty: the default device)
 };
 
 // A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides
 // when the scenario asks for it, and reset to the groom with `params`.
 std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
-                                      ThreadPool& pool);
+                                      ThreadPool& pool, const std::string& device = "");
 // The input of frame f: the head script evaluated at both ends of the step.
 FrameInput frame_input(const Scenario& sc, int f);
 

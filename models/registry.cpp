@@ -10,6 +10,9 @@
 #include "models/halen_spring/settings.h"
 #include "models/plante_wisp/model.h"
 #include "models/plante_wisp/settings.h"
+#ifdef HAIRBENCH_HAS_VULKAN
+#include "models/han_vk/model.h"
+#endif
 
 #include <vector>
 
@@ -31,6 +34,17 @@ std::span<const ModelInfo> model_registry() {
        halen_forest::kParams, [](const ModelContext& c) { return halen_forest::make(c); }},
       {"plante_wisp", "Plante, Cani & Poulin 2001: layered wisps (skeleton, envelope, strands) with anisotropic interactions (§3-5)",
        plante::kParams, [](const ModelContext& c) { return plante::make_plante_wisp(c); }},
+#ifdef HAIRBENCH_HAS_VULKAN
+      {"han_m1_vk", "Han & Harada 2012 method 1 on a Vulkan device (§5: a workgroup per strand, shared memory)",
+       han::kParams, [](const ModelContext& c) { return han_vk::make_han_vk(han::Method::Serial, c); },
+       han_vk::unavailable},
+      {"han_m2_vk", "Han & Harada 2012 method 2 on a Vulkan device (Algorithm 4 with a barrier)",
+       han::kParams, [](const ModelContext& c) { return han_vk::make_han_vk(han::Method::Jacobi, c); },
+       han_vk::unavailable},
+      {"han_m3_vk", "Han & Harada 2012 method 3 on a Vulkan device (Algorithm 5)",
+       han::kParams, [](const ModelContext& c) { return han_vk::make_han_vk(han::Method::RestFrames, c); },
+       han_vk::unavailable},
+#endif
   };
   return models;
 }

@@ -16,6 +16,9 @@ struct ModelInfo {
   std::string_view summary;  // one line, with the paper section it implements
   std::span<const ParamSpec> params;
   std::function<std::unique_ptr<HairModel>(const ModelContext&)> make;
+  // For models that need hardware that may be missing (a Vulkan device): why the model
+  // cannot run in this context, or "" when it can. Empty function: always available.
+  std::function<std::string(const ModelContext&)> unavailable = {};
 };
 
 std::span<const ModelInfo> model_registry();

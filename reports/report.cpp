@@ -142,6 +142,12 @@ nlohmann::json run_json(const RunRecord& r) {
       {"stage_ms", stage},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
 
+  if (!r.gpu_ms.empty())
+    timing["gpu_ms"] = {{"mean", num(finite_mean(r.gpu_ms))},
+                        {"median", num(median(r.gpu_ms))},
+                        {"min", num(*std::min_element(r.gpu_ms.begin(), r.gpu_ms.end()))},
+                        {"p95", num(percentile(r.gpu_ms, 0.95))}};
+
   // rest_shape_error averages the frames that end at or after settle_from.
   std::vector<double> settled;
   for (std::size_t f = 0; f < done; ++f)
@@ -189,6 +195,8 @@ nlohmann::json run_json(const RunRecord& r) {
                          {"penetration", series(r.penetration)}}},
                        {"snapshots", std::move(snapshots)}};
   if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
+  if (!r.device.empty()) out["device"] = r.device;
+  if (!r.gpu_ms.empty()) out["series"]["gpu_ms"] = series(r.gpu_ms);
   return out;
 }
 
@@ -235,6 +243,10 @@ nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord
     j["scenarios"] = nlohmann::json::array();
     for (const ScenarioRecord& sc : scenarios) j["scenarios"].push_back(scenario_json(sc));
   }
+  for (const RunRecord& r : runs)
+    if (!r.device.empty() && std::find(j["context"]["devices"].begin(), j["context"]["devices"].end(), r.device) ==
+                                 j["context"]["devices"].end())
+      j["context"]["devices"].push_back(r.device);
   return j;
 }
 

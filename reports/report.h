@@ -19,6 +19,7 @@ struct RunRecord {
   std::string scenario;
   std::string model;
   std::string backend = "cpu";
+  std::string device;  // the GPU a GPU model ran on (run "device"; context "devices")
   std::size_t strands = 0, vertices = 0;
   int frames = 0;  // frames requested
   double dt = 0.0;
@@ -35,6 +36,7 @@ struct RunRecord {
   std::string reference;  // model the deviation is measured against
   // Per frame actually run (a failed run stops early).
   std::vector<double> step_ms;
+  std::vector<double> gpu_ms;  // device time per step, GPU models with timestamps only
   std::vector<double> deviation;  // NaN where the reference had already failed
   std::vector<double> jaggedness;
   std::vector<double> length_rms, length_max;

@@ -177,8 +177,7 @@ void keep_outside(const Vec3d& p, double edge, double keep_out, Vec3d& w, Vec3d&
 }
 
 std::vector<Vec3f> grow_strand(const GroomSpec& spec, Style style, double r, const Root& root,
-                               const Comb& comb, double phase) {
-  const int n = spec.vertices_per_strand;
+                               const Comb& comb, double phase, int n) {
   const double edge = spec.length / (n - 1);
   const double keep_out = r * (1.0 + kMargin);
   std::vector<Vec3f> points;
@@ -244,6 +243,9 @@ Style check_spec(const GroomSpec& spec, float head_radius, const std::string& so
   const Style style = parse_style(spec.style, source);
   check_range(spec.strands, 1, kMaxGroomStrands, false, source, "groom.strands");
   check_range(spec.vertices_per_strand, 2, kMaxStrandVertices, false, source, "groom.vertices_per_strand");
+  if (spec.total_vertices != 0)
+    check_range(static_cast<double>(spec.total_vertices), 2.0 * spec.strands,
+                static_cast<double>(kMaxStrandVertices) * spec.strands, false, source, "groom.vertices");
   check_positive(spec.length, source, "groom.length");
   check_positive(spec.wave_amplitude, source, "groom.wave_amplitude");
   check_positive(spec.wave_length, source, "groom.wave_length");
@@ -273,11 +275,15 @@ GeneratedGroom generate_groom(const GroomSpec& spec, float head_radius, const st
   } else {
     out.region_params.resize(1);
   }
-  out.groom.positions.reserve(static_cast<std::size_t>(spec.strands) * spec.vertices_per_strand);
-  for (const Root& root : roots) {
+  const std::int64_t strands = spec.strands;
+  const std::int64_t total = spec.total_vertices > 0 ? spec.total_vertices : strands * spec.vertices_per_strand;
+  out.groom.positions.reserve(static_cast<std::size_t>(total));
+  for (std::int64_t s = 0; s < strands; ++s) {
+    const Root& root = roots[static_cast<std::size_t>(s)];
     const Comb comb = ponytail ? ponytail_comb(root, r, rng) : loose_comb(root);
     const double phase = 2.0 * kPi * rng.uniform();
-    out.groom.add_strand(grow_strand(spec, style, r, root, comb, phase), comb.region);
+    const int n = static_cast<int>((s + 1) * total / strands - s * total / strands);
+    out.groom.add_strand(grow_strand(spec, style, r, root, comb, phase, n), comb.region);
   }
   validate_groom(out.groom, source);
   return out;

@@ -21,6 +21,10 @@ struct GroomSpec {
   std::string style = "straight";  // straight | wavy | curly | ponytail
   int strands = 2000;
   int vertices_per_strand = 16;
+  // > 0: the groom's total vertex count instead of vertices_per_strand; strands get
+  // floor or ceil of the mean, spread evenly, so a published groom size (Han & Harada
+  // Table 1: 19,776 strands, 221,078 vertices) is met exactly.
+  std::int64_t total_vertices = 0;
   double length = 0.25;  // metres, rest strand length
   std::uint64_t seed = 1;
   // Style shape knobs (metres). wavy: planar sine wave; curly: helix around the

@@ -486,7 +486,7 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
 
 GroomSpec read_groom_spec(const Reader& r, const json& j, const std::string& path) {
   const Obj o(r, j, path,
-              {"style", "strands", "vertices_per_strand", "length", "seed", "wave_amplitude", "wave_length",
+              {"style", "strands", "vertices_per_strand", "vertices", "length", "seed", "wave_amplitude", "wave_length",
                "curl_radius", "curl_pitch"});
   const auto styles = groom_styles();
   GroomSpec spec;
@@ -496,7 +496,14 @@ GroomSpec read_groom_spec(const Reader& r, const json& j, const std::string& pat
   if (spec.style != "wavy") o.reject({"wave_amplitude", "wave_length"}, "applies to style wavy only");
   if (spec.style != "curly") o.reject({"curl_radius", "curl_pitch"}, "applies to style curly only");
   spec.strands = static_cast<int>(o.integer("strands", 1, kMaxGroomStrands));
-  spec.vertices_per_strand = static_cast<int>(o.integer("vertices_per_strand", 2, kMaxStrandVertices));
+  // Either vertices per strand or the groom's total (strands then differ by at most one).
+  if (o.has("vertices") == o.has("vertices_per_strand"))
+    r.fail(o.key("vertices_per_strand"), "give exactly one of vertices_per_strand and vertices");
+  if (o.has("vertices"))
+    spec.total_vertices = o.integer("vertices", 2 * std::int64_t{spec.strands},
+                                    std::int64_t{kMaxStrandVertices} * spec.strands);
+  else
+    spec.vertices_per_strand = static_cast<int>(o.integer("vertices_per_strand", 2, kMaxStrandVertices));
   spec.length = o.number("length");
   spec.seed = as_seed(r, o.at("seed"), o.key("seed"));
   spec.wave_amplitude = o.number_or("wave_amplitude", spec.wave_amplitude);

@@ -598,5 +598,20 @@ TEST(HeadMotion, OscillatorsRotateAboutTheHeadCentre) {
   EXPECT_TRUE(a.linear().isApprox(expected, 1e-5f));
 }
 
+// groom.vertices meets a published groom size exactly (Han & Harada Table 1, model 1:
+// 19,776 strands, 221,078 vertices), strands differing by at most one vertex.
+TEST(GroomVertices, ExactTotalForTheTable1Sizes) {
+  const Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_TEST_DATA_DIR) / "../../scenarios/paper/han2012_model1.json");
+  EXPECT_EQ(sc.groom.strand_count(), 19776u);
+  EXPECT_EQ(sc.groom.vertex_count(), 221078u);
+  std::uint32_t lo = UINT32_MAX, hi = 0;
+  for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) {
+    lo = std::min(lo, sc.groom.strand_size(s));
+    hi = std::max(hi, sc.groom.strand_size(s));
+  }
+  EXPECT_EQ(lo, 11u);
+  EXPECT_EQ(hi, 12u);
+}
+
 }  // namespace
 }  // namespace hairbench

@@ -1,0 +1,147 @@
+// A small Vulkan compute runtime: the loader (opened at run time, so binaries start on
+// machines without Vulkan), device selection, buffers, one compute pipeline with its
+// descriptor set, command buffers, fences and timestamp queries.
+#pragma once
+
+#define VK_NO_PROTOTYPES
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace hairbench::vk {
+
+// No Vulkan loader, no instance, or no device at all: the one-line reason. Tests skip
+// on this (and only this); the CLI leaves Vulkan models out with it.
+class Unavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct DeviceInfo {
+  std::uint32_t index;
+  std::string name;
+  std::string type;  // "discrete GPU", "integrated GPU", "CPU", ...
+};
+
+// The devices the loader reports; throws Unavailable when there is no loader or device.
+std::vector<DeviceInfo> list_devices();
+
+class Context;
+
+// A buffer and its memory. Host-visible memory stays mapped (mapped() != nullptr).
+class Buffer {
+ public:
+  Buffer() = default;
+  ~Buffer();
+  Buffer(Buffer&& o) noexcept { swap(o); }
+  Buffer& operator=(Buffer&& o) noexcept {
+    swap(o);
+    return *this;
+  }
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+
+  VkBuffer handle() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  void* mapped() const { return mapped_; }
+
+ private:
+  friend class Context;
+  void swap(Buffer& o) noexcept;
+  const Context* ctx_ = nullptr;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  void* mapped_ = nullptr;
+};
+
+// Where a buffer lives: on the device (mapped too when the device offers host-visible
+// device memory, as CPU devices and resizable-BAR GPUs do), or in host memory the
+// device reads and writes (per-frame uploads, readback).
+enum class Memory { Device, Host };
+
+// A compute pipeline over `bindings` storage buffers (set 0) with specialization
+// constants 0..n-1, its descriptor set, and a command buffer with a fence and two
+// timestamp queries around whatever is recorded.
+class Kernel {
+ public:
+  ~Kernel();
+  Kernel(const Kernel&) = delete;
+  Kernel& operator=(const Kernel&) = delete;
+
+  // Points binding i at buffers[i].
+  void bind(std::span<const Buffer* const> buffers);
+  // Records: timestamp, dispatch(groups), barrier making the writes visible to the host
+  // and to transfers, timestamp.
+  void record_dispatch(std::uint32_t groups);
+  // Submits what was recorded and waits for it.
+  void run();
+  // Device time between the two timestamps of the last run(), in ms; nullopt when the
+  // queue has no timestamps.
+  std::optional<double> last_ms() const;
+
+ private:
+  friend class Context;
+  explicit Kernel(const Context& ctx) : ctx_(ctx) {}
+  const Context& ctx_;
+  VkShaderModule module_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkQueryPool queries_ = VK_NULL_HANDLE;
+  std::uint32_t bindings_ = 0;
+};
+
+class Context {
+ public:
+  // The shared context for a device: `spec` empty picks the first discrete GPU, else
+  // the first device; a number picks by index (list_devices order); anything else is
+  // matched case-insensitively against device names. Throws Unavailable when Vulkan or
+  // any device is missing, and InputError("--device", spec, ...) when nothing matches.
+  static std::shared_ptr<Context> get(const std::string& spec);
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  const DeviceInfo& device() const { return info_; }
+
+  Buffer buffer(VkDeviceSize size, Memory where) const;
+  // Copies bytes into the buffer (through a staging buffer when it is not mapped).
+  void upload(Buffer& dst, const void* data, std::size_t bytes) const;
+  // Copies the buffer's first `bytes` out (through a staging buffer when not mapped).
+  void download(const Buffer& src, void* data, std::size_t bytes) const;
+
+  std::unique_ptr<Kernel> kernel(std::span<const std::uint32_t> spirv, std::uint32_t bindings,
+                                 std::span<const std::uint32_t> specialization) const;
+
+ private:
+  friend class Buffer;
+  friend class Kernel;
+  Context() = default;
+  void init(const std::string& spec);
+  VkCommandBuffer begin_once() const;
+  void submit_and_wait(VkCommandBuffer cmd, VkFence fence) const;
+  void copy(VkBuffer src, VkBuffer dst, VkDeviceSize bytes) const;
+  std::uint32_t memory_type(std::uint32_t allowed, Memory where) const;
+
+  DeviceInfo info_;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  std::uint32_t queue_family_ = 0;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties memory_{};
+  double timestamp_period_ns_ = 0.0;  // 0: the queue has no timestamps
+  std::uint64_t timestamp_mask_ = 0;
+};
+
+}  // namespace hairbench::vk

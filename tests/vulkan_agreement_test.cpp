@@ -1,0 +1,50 @@
+// The Vulkan models against the CPU models on the scenarios and on every
+// shipped scenario (slow on lavapipe: label slow). Method 3 on shake is in vulkan_test.
+#include "vulkan_support.h"
+
+namespace hairbench {
+namespace {
+
+using test::agreement;
+
+// After 120 frames every vertex within 1e-4 of L-bar of the CPU model's.
+void expect_agreement(const std::string& scenario, const std::string& method) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = test::builtin(scenario, 25);
+  const test::Agreement a = agreement(sc, method, method + "_vk", 120);
+  EXPECT_GT(a.max_displacement, 0.05 * a.mean_length) << "the scenario should move the hair";
+  EXPECT_LT(a.max_diff, 1e-4 * a.mean_length);
+}
+
+TEST(VulkanAgreement, Method1Shake) { expect_agreement("shake", "han_m1"); }
+TEST(VulkanAgreement, Method2Shake) { expect_agreement("shake", "han_m2"); }
+TEST(VulkanAgreement, Method1Ponytail) { expect_agreement("ponytail", "han_m1"); }
+TEST(VulkanAgreement, Method2Ponytail) { expect_agreement("ponytail", "han_m2"); }
+TEST(VulkanAgreement, Method3Ponytail) { expect_agreement("ponytail", "han_m3"); }
+
+// Every built-in scenario through its head motion and half a second of settling (150
+// frames; every script moves in the first 2 s), thinned groom: the Vulkan models are stable
+// whenever the CPU model is, and stay with it (deviation against the CPU method of the
+// same number, RMS over vertices / L-bar, every frame).
+TEST(VulkanModels, StableOnEveryBuiltinScenario) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  for (const std::filesystem::path& file : builtin_scenarios()) {
+    const std::string name = file.stem().string();
+    const Scenario sc = test::builtin(name, 50);
+    for (const char* m : {"han_m1", "han_m2", "han_m3"}) {
+      ThreadPool pool(2);
+      RunOptions opt;
+      opt.models = {std::string(m) + "_vk"};
+      opt.reference = m;
+      opt.frames = 150;
+      const auto runs = run_scenario(sc, opt, pool);
+      ASSERT_EQ(runs.size(), 1u);
+      const RunRecord& r = runs[0];
+      EXPECT_FALSE(r.failure) << name << " " << r.model << ": " << (r.failure ? r.failure->reason : "");
+      EXPECT_LT(test::max_of(r.deviation), 1e-4) << name << " " << r.model;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hairbench
