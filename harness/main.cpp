@@ -2,16 +2,20 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/runner.h"
+#include "harness/stress.h"
 #include "models/registry.h"
 #include "reports/report.h"
 #include "scenarios/scenario.h"
 
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <regex>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 namespace hairbench {
 namespace {
@@ -20,12 +24,19 @@ constexpr const char* kUsage = R"(usage:
   hairbench list models|scenarios
   hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL]
                     [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR]
+  hairbench stress [--models REGEX] [--base SCENARIO] [--axes REGEX] [--keep-every N]
+                   [--quick] [--threads N] [--out DIR]
 
 compare runs every selected model in lockstep on each scenario (default: every built-in
 scenario) and writes DIR/report.json (default DIR: reports/out/latest).
   --models REGEX     models whose whole name matches (default: all)
   --reference MODEL  deviation is measured against MODEL (default: the scenario's, han_m1)
   --set M.NAME=V     parameter override; M may be * for every model that has NAME
+stress escalates one axis at a time (time step, head angular velocity and acceleration,
+teleports, strand vertices and length, every stiffness, iteration count and damping)
+from the stable base scenario (default shake, every 10th strand) until each model fails,
+runs degenerate grooms, prints the table and writes DIR/stress.json (default DIR:
+reports/out/stress). --quick tries every other value of each axis.
 exit codes: 0 done (unstable models are results, not errors), 2 bad arguments or files)";
 
 struct CompareArgs {
@@ -50,6 +61,21 @@ int parse_int(const std::string& flag, const std::string& v, int lo, int hi) {
   return static_cast<int>(x);
 }
 
+// Every registered model whose whole name matches the --models regex.
+std::vector<std::string> select_models(const std::string& pattern) {
+  std::regex re;
+  try {
+    re = std::regex(pattern);
+  } catch (const std::regex_error& e) {
+    throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
+  }
+  std::vector<std::string> names;
+  for (const ModelInfo& m : model_registry())
+    if (std::regex_match(std::string(m.name), re)) names.emplace_back(m.name);
+  if (names.empty()) throw InputError("arguments", "--models", "'" + pattern + "' matches no model");
+  return names;
+}
+
 CompareArgs parse_compare(const std::vector<std::string>& args) {
   CompareArgs a;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -70,15 +96,7 @@ CompareArgs parse_compare(const std::vector<std::string>& args) {
     } else if (flag == "--out") a.out = value();
     else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
   }
-  std::regex re;
-  try {
-    re = std::regex(a.models);
-  } catch (const std::regex_error& e) {
-    throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
-  }
-  for (const ModelInfo& m : model_registry())
-    if (std::regex_match(std::string(m.name), re)) a.run.models.emplace_back(m.name);
-  if (a.run.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model");
+  a.run.models = select_models(a.models);
   if (!a.run.reference.empty() && !find_model(a.run.reference))
     throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "'");
   return a;
@@ -134,6 +152,45 @@ int cmd_compare(const std::vector<std::string>& args) {
   return 0;
 }
 
+int cmd_stress(const std::vector<std::string>& args) {
+  StressOptions opt;
+  std::string models = ".*", out = "reports/out/stress";
+  int threads = 0;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& flag = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw InputError("arguments", flag, "needs a value");
+      return args[++i];
+    };
+    if (flag == "--models") models = value();
+    else if (flag == "--base") opt.base = value();
+    else if (flag == "--axes") opt.axes = value();
+    else if (flag == "--keep-every") opt.keep_every = static_cast<std::size_t>(parse_int(flag, value(), 1, 1'000'000));
+    else if (flag == "--quick") opt.value_stride = 2;
+    else if (flag == "--threads") threads = parse_int(flag, value(), 1, 1024);
+    else if (flag == "--out") out = value();
+    else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
+  }
+  opt.models = select_models(models);
+  ThreadPool pool(threads);
+  const bool tty = isatty(fileno(stderr));
+  const auto start = std::chrono::steady_clock::now();
+  const StressResult result = run_stress(opt, pool, [&](int done, int total) {
+    if (!tty) return;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "\r  stress: %d/%d runs, %.0f s elapsed, ~%.0f s left   ", done, total, s,
+                 s / done * (total - done));
+    if (done == total) std::fputc('\n', stderr);
+  });
+  std::fputs(stress_table(result).c_str(), stdout);
+  nlohmann::json report = make_report(ReportContext{pool.threads()}, {});
+  report["stress"] = stress_json(result);
+  const std::filesystem::path file = std::filesystem::path(out) / "stress.json";
+  write_json(file, report);
+  std::printf("wrote %s\n", file.string().c_str());
+  return 0;
+}
+
 int cmd_list(const std::vector<std::string>& args) {
   if (args.size() != 1) throw InputError("arguments", "list", "expected `list models` or `list scenarios`");
   if (args[0] == "models") {
@@ -159,6 +216,7 @@ int run(int argc, char** argv) {
   args.erase(args.begin());
   if (cmd == "compare") return cmd_compare(args);
   if (cmd == "list") return cmd_list(args);
+  if (cmd == "stress") return cmd_stress(args);
   throw InputError("arguments", cmd, "unknown command (see hairbench --help)");
 }
 

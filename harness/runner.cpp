@@ -9,6 +9,7 @@
 #include <limits>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 namespace hairbench {
 
@@ -139,6 +140,9 @@ struct Lane {
   RunRecord record;
   bool reported;
   bool running = true;
+  // With RunOptions::energy_check: last frame's positions and the growth check.
+  std::vector<Vec4f> prev;
+  std::optional<metrics::EnergyGrowthCheck> energy;
 };
 
 }  // namespace
@@ -151,7 +155,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   // The reference runs once per scenario: it is lane 0, reported only if selected.
   std::vector<Lane> lanes;
   auto add_lane = [&](const ModelInfo* info, bool reported) {
-    Lane lane{info, nullptr, {}, reported};
+    Lane lane{info, nullptr, {}, reported, true, {}, {}};
     const ParamSet params = resolve_params(*info, sc, opt.overrides);
     lane.model = info->make(ModelContext{&pool});
     // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
@@ -166,6 +170,11 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     r.settle_from = sc.settle_from;
     r.params = params_json(params, sc.groom);
     r.reference = reference;
+    if (opt.energy_check) {
+      const auto p = lane.model->positions();
+      lane.prev.assign(p.begin(), p.end());
+      lane.energy.emplace(mean_strand_length(sc.groom), sc.gravity.norm());
+    }
     lanes.push_back(std::move(lane));
   };
   bool ref_selected = false;
@@ -211,9 +220,15 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     }
 
     // Stability first, so that a reference failing this frame is not used as one.
+    const bool driven = in.head.matrix() != in.head_prev.matrix() || in.wind.active();
     for (Lane& l : lanes) {
       if (!l.running) continue;
-      const std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
+      std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
+      if (why.empty() && l.energy) {
+        const auto p = l.model->positions();
+        why = l.energy->add(metrics::mechanical_energy(p, l.prev, sc.dt, sc.gravity), driven);
+        l.prev.assign(p.begin(), p.end());
+      }
       if (why.empty()) continue;
       RunRecord& r = l.record;
       r.failure = RunRecord::Failure{f, in.t, why};

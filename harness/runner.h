@@ -39,6 +39,9 @@ struct RunOptions {
   std::string reference = "";       // empty: the scenario's reference
   int frames = 0;                   // > 0 overrides the scenario's frame count
   std::vector<ParamOverride> overrides;
+  // Stress runs (issue 8): a model whose mechanical energy keeps growing while the head
+  // is still and no wind blows also fails (metrics::EnergyGrowthCheck).
+  bool energy_check = false;
 };
 
 // Runs one scenario; a model that becomes unstable stops there (recorded in its
