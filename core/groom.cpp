@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hairbench {
@@ -13,6 +14,19 @@ void Groom::add_strand(std::span<const Vec3f> points, std::uint16_t region, int 
   }
   strand_offsets.push_back(static_cast<std::uint32_t>(positions.size()));
   strand_region.push_back(region);
+}
+
+Groom every_nth_strand(const Groom& g, std::size_t keep_every) {
+  Groom thin;
+  thin.region_names = g.region_names;
+  thin.head_radius = g.head_radius;
+  for (std::size_t s = 0; s < g.strand_count(); s += std::max<std::size_t>(keep_every, 1)) {
+    const auto b = g.positions.begin() + g.strand_begin(s);
+    thin.positions.insert(thin.positions.end(), b, b + g.strand_size(s));
+    thin.strand_offsets.push_back(static_cast<std::uint32_t>(thin.positions.size()));
+    thin.strand_region.push_back(g.strand_region[s]);
+  }
+  return thin;
 }
 
 std::vector<float> rest_edge_lengths(const Groom& g) {

@@ -35,6 +35,10 @@ std::vector<float> rest_edge_lengths(const Groom& g);
 // Mean rest strand length L-bar (DESIGN.md, metrics).
 double mean_strand_length(const Groom& g);
 
+// Every `keep_every`-th strand of g (strands 0, n, 2n, ...), with its region: a thinner
+// groom for tests and stress runs whose properties are per strand.
+Groom every_nth_strand(const Groom& g, std::size_t keep_every);
+
 // Checks the invariants every model relies on and throws InputError naming `source` and
 // the first offending strand: >= 2 vertices, finite positions, no zero-length edge,
 // vertices 0 and 1 pinned, offsets consistent.

@@ -4,6 +4,7 @@
 #include "harness/charts.h"
 #include "harness/progress.h"
 #include "harness/runner.h"
+#include "harness/stress.h"
 #include "models/registry.h"
 #include "reports/report.h"
 #include "scenarios/scenario.h"
@@ -11,6 +12,7 @@
 #include "kernels/vulkan/runtime.h"
 #endif
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -19,6 +21,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 namespace hairbench {
 namespace {
@@ -31,6 +35,8 @@ constexpr const char* kUsage = R"(usage:
   hairbench sweep --scenario NAME|PATH [--scenario ...] --knob NAME=V1,V2,... [--models REGEX]
                   [--reference MODEL|converged] [--frames N] [--threads N] [--set MODEL.NAME=VALUE]...
                   [--out DIR] [--no-charts]
+  hairbench stress [--models REGEX] [--base SCENARIO] [--axes REGEX] [--keep-every N]
+                   [--quick] [--threads N] [--out DIR]
 
 compare runs every selected model in lockstep on each scenario (default: every built-in
 scenario) and writes DIR/report.json (default DIR: reports/out/latest), then its charts,
@@ -44,6 +50,11 @@ report whose runs carry the value as "knob" (default DIR: reports/out/sweep).
   --no-charts        write the report only
   --device D         Vulkan device of the *_vk models, by index or name (see list
                      devices; default: the first discrete GPU, else any device)
+stress escalates one axis at a time (time step, head angular velocity and acceleration,
+teleports, strand vertices and length, every stiffness, iteration count and damping)
+from the stable base scenario (default shake, every 10th strand) until each model fails,
+runs degenerate grooms, prints the table and writes DIR/stress.json (default DIR:
+reports/out/stress). --quick tries every other value of each axis.
 exit codes: 0 done (unstable models are results, not errors), 1 internal error or chart
 script failure, 2 bad arguments or files)";
 
@@ -307,6 +318,55 @@ int cmd_sweep(const std::vector<std::string>& args) {
   return write_report(a, pool, runs, records, sweep);
 }
 
+int cmd_stress(const std::vector<std::string>& args) {
+  StressOptions opt;
+  std::string models = ".*", out = "reports/out/stress";
+  int threads = 0;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& flag = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw InputError("arguments", flag, "needs a value");
+      return args[++i];
+    };
+    if (flag == "--models") models = value();
+    else if (flag == "--base") opt.base = value();
+    else if (flag == "--axes") opt.axes = value();
+    else if (flag == "--keep-every") opt.keep_every = static_cast<std::size_t>(parse_int(flag, value(), 1, 1'000'000));
+    else if (flag == "--quick") opt.value_stride = 2;
+    else if (flag == "--threads") threads = parse_int(flag, value(), 1, 1024);
+    else if (flag == "--out") out = value();
+    else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
+  }
+  // The CPU models: the GPU variants run the same algorithms (issue 7's agreement
+  // tests), and on a CPU Vulkan device a sweep of them would take hours.
+  std::regex re;
+  try {
+    re = std::regex(models);
+  } catch (const std::regex_error& e) {
+    throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
+  }
+  for (const ModelInfo& m : model_registry())
+    if (!m.unavailable && std::regex_match(std::string(m.name), re)) opt.models.emplace_back(m.name);
+  if (opt.models.empty()) throw InputError("arguments", "--models", "'" + models + "' matches no CPU model");
+  ThreadPool pool(threads);
+  const bool tty = isatty(fileno(stderr));
+  const auto start = std::chrono::steady_clock::now();
+  const StressResult result = run_stress(opt, pool, [&](int done, int total) {
+    if (!tty) return;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "\r  stress: %d/%d runs, %.0f s elapsed, ~%.0f s left   ", done, total, s,
+                 s / done * (total - done));
+    if (done == total) std::fputc('\n', stderr);
+  });
+  std::fputs(stress_table(result).c_str(), stdout);
+  nlohmann::json report = make_report(ReportContext{pool.threads()}, {});
+  report["stress"] = stress_json(result);
+  const std::filesystem::path file = std::filesystem::path(out) / "stress.json";
+  write_json(file, report);
+  std::printf("wrote %s\n", file.string().c_str());
+  return 0;
+}
+
 int cmd_list(const std::vector<std::string>& args) {
   if (args.size() != 1)
     throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
@@ -347,6 +407,7 @@ int run(int argc, char** argv) {
   if (cmd == "compare") return cmd_compare(args);
   if (cmd == "sweep") return cmd_sweep(args);
   if (cmd == "list") return cmd_list(args);
+  if (cmd == "stress") return cmd_stress(args);
   throw InputError("arguments", cmd, "unknown command (see hairbench --help)");
 }
 

@@ -11,6 +11,7 @@
 #include <limits>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 namespace hairbench {
 
@@ -141,6 +142,9 @@ struct Lane {
   RunRecord record;
   bool reported;
   bool running = true;
+  // With RunOptions::energy_check: last frame's positions and the growth check.
+  std::vector<Vec4f> prev;
+  std::optional<metrics::EnergyGrowthCheck> energy;
 };
 
 bool same_params(const ParamSet& a, const ParamSet& b) { return a.base() == b.base() && a.regions() == b.regions(); }
@@ -224,7 +228,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   // of its model when that run's parameters are the same.
   std::vector<Lane> lanes;
   auto add_lane = [&](const ModelInfo* info, const ParamSet& params, bool reported) {
-    Lane lane{info, make_model(*info, sc, params, pool, opt.device), {}, reported};
+    Lane lane{info, make_model(*info, sc, params, pool, opt.device), {}, reported, true, {}, {}};
     RunRecord& r = lane.record;
     r.scenario = sc.name;
     r.model = std::string(info->name);
@@ -240,6 +244,11 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     r.reference_overrides = ref_overrides;
     if (reported) r.knob = opt.knob;
     r.snapshots = {{"most_violent", -1, {}}, {"final", -1, {}}};
+    if (opt.energy_check) {
+      const auto p = lane.model->positions();
+      lane.prev.assign(p.begin(), p.end());
+      lane.energy.emplace(mean_strand_length(sc.groom), sc.gravity.norm());
+    }
     lanes.push_back(std::move(lane));
   };
   const ParamSet ref_params = resolve_params(*ref_info, sc, concat(opt.overrides, opt.reference_overrides));
@@ -292,9 +301,15 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     }
 
     // Stability first, so that a reference failing this frame is not used as one.
+    const bool driven = in.head.matrix() != in.head_prev.matrix() || in.wind.active();
     for (Lane& l : lanes) {
       if (!l.running) continue;
-      const std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
+      std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
+      if (why.empty() && l.energy) {
+        const auto p = l.model->positions();
+        why = l.energy->add(metrics::mechanical_energy(p, l.prev, sc.dt, sc.gravity), driven);
+        l.prev.assign(p.begin(), p.end());
+      }
       if (why.empty()) continue;
       RunRecord& r = l.record;
       r.failure = RunRecord::Failure{f, in.t, why};

@@ -53,6 +53,9 @@ struct RunOptions {
   // the reference's snapshots.
   ScenarioRecord* scenario_record = nullptr;
   std::string device;  // GPU models' --device (empty: the default device)
+  // Stress runs (issue 8): a model whose mechanical energy keeps growing while the head
+  // is still and no wind blows also fails (metrics::EnergyGrowthCheck).
+  bool energy_check = false;
 };
 
 // A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides

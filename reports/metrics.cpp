@@ -133,6 +133,37 @@ std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const 
   return {};
 }
 
+double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt, const Vec3f& gravity) {
+  if (p.empty()) return 0.0;
+  const Eigen::Vector3d g = gravity.cast<double>();
+  double e = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Eigen::Vector3d v = (xyz(p[i]) - xyz(prev[i])) / dt;
+    e += 0.5 * v.squaredNorm() - g.dot(xyz(p[i]));
+  }
+  return e / static_cast<double>(p.size());
+}
+
+std::string EnergyGrowthCheck::add(double energy, bool driven) {
+  if (driven) {  // energy may rise while the head or the wind works on the hair
+    sum_ = 0.0;
+    in_window_ = 0;
+    have_last_ = false;
+    rising_ = 0;
+    return {};
+  }
+  sum_ += energy;
+  if (++in_window_ < kWindow) return {};
+  const double mean = sum_ / kWindow;
+  sum_ = 0.0;
+  in_window_ = 0;
+  rising_ = (have_last_ && mean - last_mean_ > min_rise_) ? rising_ + 1 : 0;
+  last_mean_ = mean;
+  have_last_ = true;
+  if (rising_ < kWindows) return {};
+  return "mechanical energy grew for " + std::to_string(kWindow * kWindows) + " frames with the head still and no wind";
+}
+
 std::uint64_t state_hash(std::span<const Vec4f> p) {
   std::uint64_t h = 1469598103934665603ull;
   for (const Vec4f& v : p)

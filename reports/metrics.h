@@ -54,6 +54,38 @@ double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_sphere
 // 10 L-bar from the head (beyond the head's extent about `head_center`: see metrics.cpp).
 std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center);
 
+// Mean specific mechanical energy per vertex, in J/kg: kinetic ½|v|² with the frame's
+// velocity v = (p - prev) / dt, plus gravitational -g·p. The stress test's growth check
+// (issue 8) watches it while nothing drives the hair.
+double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt, const Vec3f& gravity);
+
+// Issue 8's "energy growing for N frames with the head still": the frames are grouped in
+// windows of kWindow; a model fails when, with the head still and no wind for the whole
+// time, the window mean of mechanical_energy rose by more than kRise * g * L-bar (every
+// vertex lifted by 5% of a strand length) over each of kWindows consecutive windows, i.e.
+// for N = kWindow * kWindows = 60 frames (after a first window to compare with). A damped model at rest loses energy; the
+// shape constraints may lift hair back toward its rest shape, but not by that much for
+// that long, so only sustained growth (a slow instability) trips it.
+class EnergyGrowthCheck {
+ public:
+  static constexpr int kWindow = 10;
+  static constexpr int kWindows = 6;
+  static constexpr double kRise = 0.05;
+  EnergyGrowthCheck(double mean_strand_length, double gravity_norm)
+      : min_rise_(kRise * gravity_norm * mean_strand_length) {}
+  // One frame's energy and whether anything drove the hair during it (head moved, wind
+  // blew). Returns a failure reason, or "" while the check holds.
+  std::string add(double energy, bool driven);
+
+ private:
+  double min_rise_;
+  double sum_ = 0.0;
+  int in_window_ = 0;
+  double last_mean_ = 0.0;
+  bool have_last_ = false;
+  int rising_ = 0;
+};
+
 // 64-bit FNV-1a over the bits of every position (xyzw): bit-exact determinism checks.
 std::uint64_t state_hash(std::span<const Vec4f> p);
 std::string hash_hex(std::uint64_t h);

@@ -124,7 +124,7 @@ const std::string kTinyShake = std::string(HAIRBENCH_TEST_DATA_DIR) + "/reports/
 
 TEST(Cli, SweepBadArgumentsExitTwo) {
   const std::string sc = " --scenario \"" + kTinyShake + "\" --no-charts --out /tmp/hairbench-cli-sweep-bad";
-  for (const std::string args :
+  for (const std::string& args :
        {std::string("sweep --knob local_iterations=1"), "sweep" + sc, "sweep" + sc + " --knob local_iterations=",
         "sweep" + sc + " --knob local_iterations=1,x", "sweep" + sc + " --knob local_iterations=1,1",
         "sweep" + sc + " --knob local_iterations=100", "sweep" + sc + " --knob nosuch=1",

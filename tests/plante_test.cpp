@@ -122,20 +122,6 @@ TEST(PlanteWisp, ParallelWispsInterpenetrateAndLoseNormalVelocity) {
   EXPECT_LT(std::hypot(d.x(), d.z()), 0.01);
 }
 
-// The scenario runner's frame input for frame f.
-FrameInput frame_input(const Scenario& sc, int f) {
-  FrameInput in;
-  in.frame = f;
-  in.dt = sc.dt;
-  in.t = (f + 1) * sc.dt;
-  in.head_prev = sc.head.at(f * sc.dt);
-  in.head = sc.head.at(in.t);
-  in.gravity = sc.gravity;
-  in.wind = sc.wind.at(in.t);
-  in.colliders = sc.colliders;
-  return in;
-}
-
 // §4.2: after every step no skeleton or envelope mass is inside the head sphere or any
 // collider (the penetration reaction runs on a frame's last integration step).
 TEST(PlanteWisp, NoWispMassInsideABody) {

@@ -15,18 +15,7 @@ namespace hairbench::test {
 // under test are per strand, and a thinner groom keeps the suite fast.
 inline Scenario builtin(const std::string& name, std::size_t keep_every = 8) {
   Scenario sc = load_scenario(find_scenario(name));
-  Groom thin;
-  thin.region_names = sc.groom.region_names;
-  thin.head_radius = sc.groom.head_radius;
-  thin.positions.clear();
-  thin.strand_offsets = {0};
-  for (std::size_t s = 0; s < sc.groom.strand_count(); s += keep_every) {
-    const auto b = sc.groom.positions.begin() + sc.groom.strand_begin(s);
-    thin.positions.insert(thin.positions.end(), b, b + sc.groom.strand_size(s));
-    thin.strand_offsets.push_back(static_cast<std::uint32_t>(thin.positions.size()));
-    thin.strand_region.push_back(sc.groom.strand_region[s]);
-  }
-  sc.groom = std::move(thin);
+  sc.groom = every_nth_strand(sc.groom, keep_every);
   return sc;
 }
 

@@ -23,20 +23,6 @@
 
 namespace hairbench::test {
 
-// The head script's input for frame f, as the runner builds it.
-inline FrameInput frame_input(const Scenario& sc, int f) {
-  FrameInput in;
-  in.frame = f;
-  in.dt = sc.dt;
-  in.t = (f + 1) * sc.dt;
-  in.head_prev = sc.head.at(f * sc.dt);
-  in.head = sc.head.at(in.t);
-  in.gravity = sc.gravity;
-  in.wind = sc.wind.at(in.t);
-  in.colliders = sc.colliders;
-  return in;
-}
-
 struct Agreement {
   double max_diff = 0.0;          // max over vertices and frames of |p_cpu - p_vk|, metres
   double mean_length = 0.0;       // L-bar of the groom

@@ -1,0 +1,99 @@
+// `hairbench stress` (issue 8): the energy-growth failure criterion, the degenerate
+// grooms (each runs stably or is refused at load, never NaN), and a short stress set.
+#include "core/parallel.h"
+#include "harness/stress.h"
+#include "models/registry.h"
+#include "reports/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace hairbench {
+namespace {
+
+using metrics::EnergyGrowthCheck;
+constexpr int kFramesToFail = EnergyGrowthCheck::kWindow * (EnergyGrowthCheck::kWindows + 1);
+
+std::vector<std::string> all_models() {
+  std::vector<std::string> names;
+  for (const ModelInfo& m : model_registry())
+    if (!m.unavailable) names.emplace_back(m.name);  // the CPU models, as hairbench stress
+  return names;
+}
+
+TEST(EnergyGrowthCheck, SustainedGrowthWithTheHeadStillFails) {
+  // L-bar 0.25 m, g 9.81: the threshold is 0.05 * 9.81 * 0.25 = 0.123 J/kg per window.
+  EnergyGrowthCheck check(0.25, 9.81);
+  int failed_at = -1;
+  for (int f = 0; f < 200 && failed_at < 0; ++f)
+    if (!check.add(0.02 * f, false).empty()) failed_at = f;  // +0.2 J/kg per 10 frames
+  EXPECT_EQ(failed_at, kFramesToFail - 1);
+}
+
+TEST(EnergyGrowthCheck, DecayOrSlowGrowthOrDrivenGrowthPasses) {
+  EnergyGrowthCheck decaying(0.25, 9.81), slow(0.25, 9.81), driven(0.25, 9.81);
+  for (int f = 0; f < 500; ++f) {
+    EXPECT_EQ(decaying.add(5.0 * std::exp(-0.01 * f), false), "");
+    EXPECT_EQ(slow.add(0.01 * f, false), "");  // 0.1 J/kg per window: below 0.123
+    // The head moves every 50th frame: growth never lasts 60 undriven frames.
+    EXPECT_EQ(driven.add(0.05 * f, f % 50 == 0), "");
+  }
+}
+
+TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
+  ThreadPool pool(2);
+  StressOptions opt;
+  opt.models = all_models();
+  opt.axes = "none";  // degenerate grooms only
+  const StressResult r = run_stress(opt, pool);
+  ASSERT_EQ(r.degenerate.size(), 5 * opt.models.size());
+  for (const DegenerateResult& d : r.degenerate) {
+    SCOPED_TRACE(d.model + " on " + d.name + ": " + d.reason);
+    EXPECT_NE(d.status, "unstable");
+    if (d.name == "zero_length_edge") {
+      // Refused at load with the groom and the field named.
+      EXPECT_EQ(d.status, "refused");
+      EXPECT_NE(d.reason.find("zero_length_edge"), std::string::npos);
+      EXPECT_NE(d.reason.find("zero-length edge"), std::string::npos);
+    } else {
+      EXPECT_EQ(d.status, "ok");  // these are valid grooms: every model must cope
+    }
+  }
+}
+
+TEST(Stress, ShortSetEscalatesUntilFailureAndKeepsTheBaseStable) {
+  ThreadPool pool(2);
+  StressOptions opt;
+  opt.models = all_models();
+  opt.keep_every = 100;  // 20 strands
+  opt.axes = "time_step|teleport";
+  opt.degenerate = false;
+  const StressResult r = run_stress(opt, pool);
+  ASSERT_EQ(r.axes.size(), 2 * opt.models.size());
+  for (const StressAxisResult& a : r.axes) {
+    SCOPED_TRACE(a.model + " / " + a.axis);
+    ASSERT_FALSE(a.cells.empty());
+    for (const StressCell& c : a.cells) {
+      // A failure always says why; a stable cell never carries a reason.
+      EXPECT_EQ(c.stable, c.reason.empty());
+      // The base scenario's own time step (1/60 s) is where every model is stable.
+      if (a.axis == "time_step" && c.value == 1.0 / 60) {
+        EXPECT_TRUE(c.stable) << c.reason;
+      }
+    }
+    // last stable < first failing, both from the tried values, when both exist.
+    if (a.first_failing && a.last_stable) {
+      EXPECT_LT(*a.last_stable, *a.first_failing);
+    }
+    if (a.first_failing) {
+      EXPECT_FALSE(a.reason.empty());
+    }
+  }
+  const nlohmann::json j = stress_json(r);
+  EXPECT_EQ(j["axes"].size(), r.axes.size());
+}
+
+}  // namespace
+}  // namespace hairbench
