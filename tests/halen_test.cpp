@@ -207,7 +207,7 @@ TEST(HalenModels, DeterministicAcrossRunsAndThreads) {
 // Every shipped scenario runs every model without NaN or blow-up (thinned grooms, the
 // first second of each).
 TEST(HalenModels, StableOnEveryBuiltinScenario) {
-  for (const auto& file : builtin_scenarios()) {
+  for (const auto& file : test::procedural_builtin_scenarios()) {
     const auto runs = test::run(builtin(file.stem().string(), 25), kHalen, {}, 2, 60);
     for (const RunRecord& r : runs)
       EXPECT_FALSE(r.failure) << file << " " << r.model << ": " << (r.failure ? r.failure->reason : "");

@@ -133,8 +133,7 @@ TEST(HanMethods, DeterministicAcrossRunsAndThreads) {
 // Every shipped scenario runs every method without instability. The TressFX scenarios
 // (assets in ../shared, follow hairs) have their own, thinned run in tressfx_scenario_test.
 TEST(HanMethods, StableOnEveryBuiltinScenario) {
-  for (const auto& file : builtin_scenarios()) {
-    if (file.stem().string().rfind("tressfx_", 0) == 0) continue;
+  for (const auto& file : test::procedural_builtin_scenarios()) {
     const auto runs = test::run(builtin(file.stem().string()), kHan);
     for (const RunRecord& r : runs)
       EXPECT_FALSE(r.failure) << file << " " << r.model << ": " << (r.failure ? r.failure->reason : "");

@@ -234,7 +234,7 @@ TEST(PlanteWisp, ReturnsTowardRestShapeAfterHeadStops) {
 // and a strand interpolated between a squashed and an unsquashed section is stretched
 // (max strand edge error 0.52-0.67 over the run while the skeleton strain stays < 5%).
 TEST(PlanteWisp, NoNaNOnEveryBuiltinScenario) {
-  for (const auto& file : builtin_scenarios()) {
+  for (const auto& file : test::procedural_builtin_scenarios()) {
     const Scenario sc = builtin(file.stem().string(), 16);
     plante::PlanteWispModel m(ModelContext{nullptr});
     m.reset(sc.groom, plante_params(sc.groom));

@@ -19,6 +19,17 @@ inline Scenario builtin(const std::string& name, std::size_t keep_every = 8) {
   return sc;
 }
 
+// The built-in scenarios on procedural grooms: every one but the TressFX scenarios, which
+// read ../shared and rebuild follow hairs, and have their own thinned runs in
+// tressfx_scenario_test (the Halén and Plante models are not yet checked on them; see the
+// notes of issues 4 and 5).
+inline std::vector<std::filesystem::path> procedural_builtin_scenarios() {
+  std::vector<std::filesystem::path> out;
+  for (const auto& file : builtin_scenarios())
+    if (file.stem().string().rfind("tressfx_", 0) != 0) out.push_back(file);
+  return out;
+}
+
 // Han & Harada's own setting for the claims of §6: Table 2's counts for model 1 (3 local,
 // 2 length iterations) and TressFX's sample stiffness (S_G 0.2 on the first 30% of the
 // strand, S_L 0.5), kept stable under metric gravity by substepping.

@@ -28,7 +28,7 @@ TEST(VulkanAgreement, Method3Ponytail) { expect_agreement("ponytail", "han_m3");
 // same number, RMS over vertices / L-bar, every frame).
 TEST(VulkanModels, StableOnEveryBuiltinScenario) {
   HAIRBENCH_REQUIRE_VULKAN();
-  for (const std::filesystem::path& file : builtin_scenarios()) {
+  for (const std::filesystem::path& file : test::procedural_builtin_scenarios()) {
     const std::string name = file.stem().string();
     const Scenario sc = test::builtin(name, 50);
     for (const char* m : {"han_m1", "han_m2", "han_m3"}) {
