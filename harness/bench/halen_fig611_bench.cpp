@@ -3,7 +3,7 @@
 // thesis's Pentium 4; the `shake` scenario's head motion, repeated every 2 s; each
 // model's default parameters (the counter `passes` is its substeps per frame).
 //
-//   build/release/harness/bench/hairbench_bench --benchmark_filter=HalenFig611
+//   build/release/hairbench_bench --benchmark_filter=HalenFig611
 #include "core/parallel.h"
 #include "harness/runner.h"
 #include "models/registry.h"
