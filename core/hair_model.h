@@ -18,25 +18,38 @@ class ThreadPool;
 
 // Wall time per named solver stage within one step. Fixed capacity and no allocation:
 // it is filled inside the timed step.
+//
+// A stage the scene does not need is not run and is reported through skip(), so the
+// report shows it as 0 ms and skipped rather than leaving it out (issue 8). A stage that
+// ran in any substep of the step counts as run.
 class StageTimes {
  public:
   static constexpr std::size_t kMaxStages = 12;
   struct Entry {
     std::string_view name;
     double ms = 0.0;
+    bool skipped = false;
   };
   void add(std::string_view name, double ms) {
-    for (std::size_t i = 0; i < count_; ++i)
-      if (entries_[i].name == name) {
-        entries_[i].ms += ms;
-        return;
-      }
-    if (count_ < kMaxStages) entries_[count_++] = {name, ms};
+    if (Entry* e = find(name)) {
+      e->ms += ms;
+      e->skipped = false;
+      return;
+    }
+    if (count_ < kMaxStages) entries_[count_++] = {name, ms, false};
+  }
+  void skip(std::string_view name) {
+    if (find(name) == nullptr && count_ < kMaxStages) entries_[count_++] = {name, 0.0, true};
   }
   void clear() { count_ = 0; }
   std::span<const Entry> entries() const { return {entries_.data(), count_}; }
 
  private:
+  Entry* find(std::string_view name) {
+    for (std::size_t i = 0; i < count_; ++i)
+      if (entries_[i].name == name) return &entries_[i];
+    return nullptr;
+  }
   std::array<Entry, kMaxStages> entries_{};
   std::size_t count_ = 0;
 };

@@ -297,7 +297,10 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
       const auto end = std::chrono::steady_clock::now();
       l.record.step_ms.push_back(std::chrono::duration<double, std::milli>(end - start).count());
       if (const auto gpu = l.model->last_gpu_ms()) l.record.gpu_ms.push_back(*gpu);
-      for (const auto& e : times.entries()) l.record.stage_ms_total[std::string(e.name)] += e.ms;
+      for (const auto& e : times.entries()) {
+        l.record.stage_ms_total[std::string(e.name)] += e.ms;
+        if (e.skipped) ++l.record.stage_skipped_steps[std::string(e.name)];
+      }
     }
 
     // Stability first, so that a reference failing this frame is not used as one.

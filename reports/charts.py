@@ -310,6 +310,15 @@ def chart_stages(report, out_dir, stem, written):
             ax.bar(range(len(runs)), vals, bottom=bottom, color=stage_colour[stage], label=stage)
             bottom = [b + v for b, v in zip(bottom, vals)]
             segments.append(stage)
+        # Stages a scene did not need are 0 ms; name them over the bar so "skipped" is
+        # visible rather than silently absent (issue 8).
+        skipped_runs = 0
+        for i, r in enumerate(runs):
+            skipped = sorted(r["timing"].get("stage_skipped_steps", {}))
+            if skipped:
+                skipped_runs += 1
+                ax.annotate("skipped: " + ", ".join(skipped), (i, bottom[i]), xytext=(0, 3),
+                            textcoords="offset points", ha="center", va="bottom", fontsize=6, rotation=90)
         ax.set_xticks(range(len(runs)))
         ax.set_xticklabels(labels, rotation=40 if len(runs) > 3 else 0, ha="right" if len(runs) > 3 else "center",
                            fontsize=7)
@@ -317,7 +326,7 @@ def chart_stages(report, out_dir, stem, written):
         ax.set_title(f"{name}: time per solver stage", fontsize=9)
         ax.legend(fontsize=7)
         ax.grid(True, axis="y", alpha=0.25)
-        panels.append({"scenario": name, "bars": len(runs), "stages": segments})
+        panels.append({"scenario": name, "bars": len(runs), "stages": segments, "runs_with_skipped": skipped_runs})
     fig.tight_layout()
     return {"files": save(fig, out_dir, stem, "stages", written), "panels": panels}
 

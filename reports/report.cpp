@@ -140,6 +140,7 @@ nlohmann::json run_json(const RunRecord& r) {
         {"min", num(r.step_ms.empty() ? NAN : *std::min_element(r.step_ms.begin(), r.step_ms.end()))},
         {"p95", num(percentile(r.step_ms, 0.95))}}},
       {"stage_ms", stage},
+      {"stage_skipped_steps", r.stage_skipped_steps},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
 
   if (!r.gpu_ms.empty())

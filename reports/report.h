@@ -44,6 +44,8 @@ struct RunRecord {
   std::vector<double> penetration;
   std::vector<double> t;  // time at the end of each frame
   std::map<std::string, double> stage_ms_total;  // summed over the run
+  // Steps in which a stage was not needed and not run (issue 8); absent when never.
+  std::map<std::string, std::size_t> stage_skipped_steps;
   std::uint64_t state_hash = 0;
 
   // Parameters given to the reference on top of the scenario's (--reference converged);
