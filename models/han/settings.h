@@ -15,7 +15,7 @@
 
 namespace hairbench::han {
 
-inline constexpr std::array<ParamSpec, 8> kParams{{
+inline constexpr std::array<ParamSpec, 9> kParams{{
     {"damping", 0.03, 0.0, 1.0, false,
      "fraction of velocity removed per (sub)step in Verlet (Halén Eq. 4.1: k = 1 - damping)"},
     {"global_stiffness", 0.2, 0.0, 1.0, false, "S_G of Eq. 2; 1 freezes hair to the rest shape"},
@@ -27,6 +27,8 @@ inline constexpr std::array<ParamSpec, 8> kParams{{
     {"local_iterations", 1, 0, 64, true, "local shape constraint iterations per (sub)step"},
     {"length_iterations", 3, 0, 64, true, "edge length constraint iterations per (sub)step"},
     {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
+    {"method", 0, 0, 3, true,
+     "local shape method for this region: 1, 2 or 3, 0 = the model's own (§6: a cheaper method as LOD)"},
 }};
 
 }  // namespace hairbench::han
