@@ -97,6 +97,11 @@ class HairModel {
   // Same topology as the groom given to reset(): strand s, vertex i, world space.
   virtual std::span<const Vec4f> positions() const = 0;
   virtual Backend backend() const { return {}; }
+  // Bytes of state one step reads and writes (positions and every per-vertex array the
+  // solver keeps), for the roofline probe of hairbench_bench: a model's step time over
+  // the time to stream this many bytes is its roofline_ratio. The default counts the
+  // positions twice (current and previous), the least a Verlet model touches.
+  virtual std::size_t state_bytes() const { return 2 * positions().size_bytes(); }
   // Device time of the last step() from GPU timestamps (report timing.gpu_ms); nullopt
   // for models that do not run on a GPU.
   virtual std::optional<double> last_gpu_ms() const { return std::nullopt; }

@@ -2,6 +2,7 @@
 
 #include "models/han/model.h"
 #include "models/han/settings.h"
+#include "models/han_fused/model.h"
 #include "models/halen_cascade/model.h"
 #include "models/halen_cascade/settings.h"
 #include "models/halen_forest/model.h"
@@ -20,11 +21,17 @@ namespace hairbench {
 
 std::span<const ModelInfo> model_registry() {
   static const std::vector<ModelInfo> models = {
-      {"han_m1", "Han & Harada 2012 method 1: serial exact local/global transforms (Algorithm 3)",
+      {"han_m1", "Han & Harada 2012 method 1: serial exact local/global transforms (Algorithm 3); fused SoA kernel",
+       han::kParams, [](const ModelContext& c) { return han_fused::make(han::Method::Serial, c); }},
+      {"han_m2", "Han & Harada 2012 method 2: Jacobi transforms from the last iteration (Algorithm 4); fused SoA kernel",
+       han::kParams, [](const ModelContext& c) { return han_fused::make(han::Method::Jacobi, c); }},
+      {"han_m3", "Han & Harada 2012 method 3: rest-state transforms (Algorithm 5); fused SoA kernel",
+       han::kParams, [](const ModelContext& c) { return han_fused::make(han::Method::RestFrames, c); }},
+      {"han_m1_ref", "han_m1 as one stage at a time over all strands (per-strand kernels; the reference for han_m1)",
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Serial, c); }},
-      {"han_m2", "Han & Harada 2012 method 2: Jacobi transforms from the last iteration (Algorithm 4)",
+      {"han_m2_ref", "han_m2 as one stage at a time over all strands (per-strand kernels; the reference for han_m2)",
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Jacobi, c); }},
-      {"han_m3", "Han & Harada 2012 method 3: rest-state transforms (Algorithm 5)",
+      {"han_m3_ref", "han_m3 as one stage at a time over all strands (per-strand kernels; the reference for han_m3)",
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::RestFrames, c); }},
       {"halen_spring", "Halén & Wester 2007 §4.4: springs to head-fixed reference nodes, tilt-weakened (§5.9)",
        halen_spring::kParams, [](const ModelContext& c) { return halen_spring::make(c); }},

@@ -9,7 +9,18 @@
 // same frames as a `hairbench compare` run. Use --benchmark_repetitions for spread.
 //
 // Counters: ns_per_vertex (mean step time / vertices), deviation_vs_reference (RMS over
-// frames, / L-bar), jaggedness (mean over frames).
+// frames, / L-bar), jaggedness (mean over frames), roofline_ratio (mean step time over
+// the time to stream the model's state_bytes() once, read and write, on all threads:
+// measured in the same process just before the model runs, so the ratio survives a
+// noisy machine) and state_mib.
+//
+// Besides the built-in scenarios, the paper's grooms (scenarios/paper, e.g.
+// han2012_model1: Table 1 model 1, 19,776 strands) are registered too.
+// BM_step_1thread/... is the same benchmark on one thread (thread scaling, issue 10).
+//
+// The roofline probes: BM_roofline_stream/bytes:N streams a buffer (read + write) on all
+// threads, in GB/s; BM_roofline_fma runs independent fused multiply-add chains on all
+// threads at the widest vector width the CPU has, in GFLOP/s.
 #include "core/parallel.h"
 #include "harness/runner.h"
 #include "reports/metrics.h"
@@ -17,11 +28,19 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 namespace hairbench {
 namespace {
@@ -48,8 +67,32 @@ Scenario thinned(const Scenario& sc, std::size_t keep_every) {
   return out;
 }
 
-void bm_step(benchmark::State& state, const ModelInfo* info, const Scenario* sc) {
-  ThreadPool pool(0);
+// Seconds to stream `bytes` once (every float read, scaled and written back) with all
+// threads of `pool`, the best of a few passes after a warm-up; cached per size and
+// thread count.
+double stream_seconds(std::size_t bytes, ThreadPool& pool) {
+  static std::map<std::pair<std::size_t, int>, double> cache;
+  const auto key = std::make_pair(bytes, pool.threads());
+  if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  std::vector<float> buf(std::max<std::size_t>(bytes / sizeof(float), 1), 1.0f);
+  float* p = buf.data();
+  const std::size_t n = buf.size();
+  double best = 1e30;
+  for (int pass = 0; pass < 12; ++pass) {
+    const auto start = std::chrono::steady_clock::now();
+    pool.parallel_for(n, [p](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) p[i] = p[i] * 0.999f + 0.001f;
+    });
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (pass >= 2) best = std::min(best, s);
+  }
+  benchmark::DoNotOptimize(buf.data());
+  cache[key] = best;
+  return best;
+}
+
+void bm_step(benchmark::State& state, const ModelInfo* info, const Scenario* sc, int threads) {
+  ThreadPool pool(threads);
   std::unique_ptr<HairModel> model = make_model(*info, *sc, resolve_params(*info, *sc, {}), pool);
   const ModelInfo* ref_info = find_model(sc->reference);
   // The reference itself needs no second lane: its deviation is 0 by definition.
@@ -81,24 +124,119 @@ void bm_step(benchmark::State& state, const ModelInfo* info, const Scenario* sc)
   state.counters["ns_per_vertex"] = step_s * 1e9 / (n * static_cast<double>(sc->groom.vertex_count()));
   state.counters["deviation_vs_reference"] = std::sqrt(dev2 / n);
   state.counters["jaggedness"] = jag / n;
+  const std::size_t bytes = model->state_bytes();
+  state.counters["state_mib"] = static_cast<double>(bytes) / (1024.0 * 1024.0);
+  state.counters["roofline_ratio"] = step_s / n / stream_seconds(bytes, pool);
   if (!stable) state.SetLabel("unstable");
 }
 
-// Registered before main() runs: every model x every loadable built-in scenario x groom size.
+void bm_roofline_stream(benchmark::State& state) {
+  ThreadPool pool(0);
+  const auto bytes = static_cast<std::size_t>(state.range(0));
+  double s = 0.0;
+  for (auto _ : state) {
+    s = stream_seconds(bytes, pool);
+    state.SetIterationTime(s);
+  }
+  state.counters["GB_per_s"] = 2.0 * static_cast<double>(bytes) / s * 1e-9;  // read + write
+}
+
+// Independent multiply-add chains, enough of them to cover the FMA latency.
+#if defined(__x86_64__)
+__attribute__((target("avx512f,fma"))) double fma_avx512(long iterations) {
+  __m512 acc[12];
+  for (int k = 0; k < 12; ++k) acc[k] = _mm512_set1_ps(static_cast<float>(k));
+  const __m512 a = _mm512_set1_ps(0.9999f), b = _mm512_set1_ps(1e-4f);
+  for (long i = 0; i < iterations; ++i)
+    for (int k = 0; k < 12; ++k) acc[k] = _mm512_fmadd_ps(acc[k], a, b);
+  __m512 sum = acc[0];
+  for (int k = 1; k < 12; ++k) sum = _mm512_add_ps(sum, acc[k]);
+  benchmark::DoNotOptimize(sum);
+  return 2.0 * 16 * 12 * static_cast<double>(iterations);
+}
+#endif
+double fma_portable(long iterations) {
+  float acc[12][4];
+  for (int k = 0; k < 12; ++k)
+    for (int l = 0; l < 4; ++l) acc[k][l] = static_cast<float>(k + l);
+  for (long i = 0; i < iterations; ++i)
+    for (int k = 0; k < 12; ++k)
+      for (int l = 0; l < 4; ++l) acc[k][l] = acc[k][l] * 0.9999f + 1e-4f;
+  benchmark::DoNotOptimize(acc);
+  return 2.0 * 4 * 12 * static_cast<double>(iterations);
+}
+
+void bm_roofline_fma(benchmark::State& state) {
+  ThreadPool pool(0);
+#if defined(__x86_64__)
+  const bool wide = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma");
+#else
+  const bool wide = false;
+#endif
+  constexpr long kIterations = 2'000'000;
+  double flops = 0.0;
+  for (auto _ : state) {
+    std::vector<double> per(static_cast<std::size_t>(pool.threads()), 0.0);
+    double* out = per.data();
+    const auto start = std::chrono::steady_clock::now();
+    pool.parallel_for(per.size(), [out, wide](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) {
+#if defined(__x86_64__)
+        out[t] = wide ? fma_avx512(kIterations) : fma_portable(kIterations);
+#else
+        out[t] = fma_portable(kIterations);
+#endif
+      }
+    });
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    flops = 0.0;
+    for (double f : per) flops += f;
+  }
+  state.counters["GFLOP_per_s"] = benchmark::Counter(flops * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(wide ? "avx512 fma" : "portable mul+add");
+}
+
+// The paper's scenarios (scenarios/paper/*.json), which the built-in list leaves out.
+std::vector<Scenario> paper_scenarios() {
+  std::vector<Scenario> out;
+  const std::filesystem::path dir = std::filesystem::path(HAIRBENCH_SCENARIO_ROOT) / "paper";
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return out;
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) out.push_back(load_scenario(f));
+  return out;
+}
+
+// Registered before main() runs: every model x every loadable built-in and paper
+// scenario x groom size, on all threads and on one.
 const bool registered = [] {
+  benchmark::RegisterBenchmark("BM_roofline_fma", bm_roofline_fma)->UseManualTime()->Iterations(3)->Unit(benchmark::kMillisecond);
+  for (long mib : {1, 4, 16, 64})
+    benchmark::RegisterBenchmark("BM_roofline_stream", bm_roofline_stream)
+        ->Arg(mib << 20)
+        ->ArgName("bytes")
+        ->UseManualTime()
+        ->Iterations(1)
+        ->Unit(benchmark::kMillisecond);
   static std::vector<std::unique_ptr<Scenario>> scenarios;
-  for (const Scenario& sc : load_builtin_scenarios(nullptr)) {
+  std::vector<Scenario> all = load_builtin_scenarios(nullptr);
+  for (Scenario& sc : paper_scenarios()) all.push_back(std::move(sc));
+  for (const Scenario& sc : all) {
     for (std::size_t keep : kThinning) {
       if (keep > 1 && sc.follow) continue;
       scenarios.push_back(std::make_unique<Scenario>(thinned(sc, keep)));
       const Scenario* s = scenarios.back().get();
       for (const ModelInfo& m : model_registry()) {
-        const std::string name = "BM_step/" + std::string(m.name) + "/" + s->name +
+        const std::string tail = "/" + std::string(m.name) + "/" + s->name +
                                  "/strands:" + std::to_string(s->groom.strand_count());
-        benchmark::RegisterBenchmark(name.c_str(), bm_step, &m, s)
-            ->UseManualTime()
-            ->Iterations(s->frames)
-            ->Unit(benchmark::kMillisecond);
+        for (const auto& [family, threads] : {std::pair{"BM_step", 0}, std::pair{"BM_step_1thread", 1}})
+          benchmark::RegisterBenchmark((family + tail).c_str(), bm_step, &m, s, threads)
+              ->UseManualTime()
+              ->Iterations(s->frames)
+              ->Unit(benchmark::kMillisecond);
       }
     }
   }

@@ -1,0 +1,103 @@
+// Han & Harada 2012 Algorithm 1 as one fused pass per block of strands, structure of
+// arrays: a block holds kLanes strands of equal vertex count, field by field and vertex by
+// vertex ([field][vertex][lane]), so one vector instruction advances kLanes strands.
+// A block stays in L1 through a whole frame: every substep's integration, global shape,
+// local shape / edge length iterations and collisions, then one write of the positions
+// back to the groom-ordered float4 array (the HairModel interface).
+//
+// Every lane performs the same floating-point operations in the same order as the
+// per-strand kernels of strand_kernels.cpp (with Eigen's evaluation order written out:
+// affine · v = t + ((m00 v0 + m01 v1) + m02 v2), |v|² = x² + (y² + z²), Eigen's SSE
+// quaternion product and q · v = v + w·2(q×v) + q×2(q×v)), and the build keeps FMA
+// contraction off, so the results are bit-identical to the reference models
+// (han_m*_ref) on any ISA variant and for any thread count.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace hairbench::kernels::han_soa {
+
+inline constexpr int kLanes = 16;
+inline constexpr std::uint32_t kNoStrand = 0xffffffffu;
+
+// Fields of a block, each n rows of kLanes floats. Method 1 adds the rest positions of
+// every vertex in its parent's frame (^{i-1}P_i^0, Algorithm 2); method 2 adds those and
+// the persistent frames (Algorithm 4).
+enum Field : int {
+  PX, PY, PZ,  // positions
+  QX, QY, QZ,  // previous positions (Verlet)
+  IW,          // inverse mass (0 = pinned)
+  RX, RY, RZ,  // rest positions in the head's rest frame
+  RL,          // rest length of edge (i-1, i), 0 at the root
+  kM3Fields,
+  LX = kM3Fields, LY, LZ,  // ^{i-1}P_i^0
+  kM1Fields,
+  OW = kM1Fields, OX, OY, OZ,  // method 2's frames wR_i, persistent across frames
+  kM2Fields
+};
+inline constexpr int field_count(int method) {
+  return method == 3 ? kM3Fields : method == 1 ? kM1Fields : kM2Fields;
+}
+// Methods 1 and 2 also keep the rest frames of vertices 0 and 1 (w, x, y, z each, one row
+// of kLanes per component) after the fields.
+inline constexpr int kRestFrameRows = 8;
+inline constexpr std::size_t block_floats(int method, int n) {
+  return static_cast<std::size_t>(field_count(method) * n + (method == 3 ? 0 : kRestFrameRows)) * kLanes;
+}
+// Floats of per-thread scratch a block of n vertices needs (method 3's head-rotated rest
+// edges, method 2's copy of the frames).
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(4 * n) * kLanes; }
+
+struct Block {
+  float* data;                      // block_floats(method, n) floats
+  int n;                            // vertices per strand
+  int method;                       // 1, 2 or 3 (Han & Harada §4.2)
+  const std::uint32_t* out_offset;  // per lane: first vertex in the float4 output, or kNoStrand
+};
+
+// Per-region solver settings, with the stages a region does not need switched off.
+struct BlockParams {
+  float keep;  // 1 - damping
+  float global_stiffness, global_reach;  // reach = global_range · n
+  bool global_on, global_ramp;
+  float local_stiffness;
+  int local_iterations;  // 0 = no local pass and no frame update
+  int length_iterations;
+};
+
+// One substep's head pose and colliders, precomputed once per step for every block.
+struct Substep {
+  float m[9];  // head linear part, row-major
+  float t[3];  // head translation
+  float q[4];  // head rotation quaternion x, y, z, w
+  float dt2;
+  float gravity_dt2[3];
+  const float* spheres;  // world-space x, y, z, r
+  int sphere_count;
+};
+
+struct Frame {
+  const Substep* substeps;
+  int substep_count;
+  float gravity[3];
+  float wind[3];  // wind acceleration; used only when windy
+  bool windy;
+};
+
+enum Stage : int { kIntegrate, kGlobal, kLocal, kLength, kCollision, kStageCount };
+
+// Advances one block by one frame and writes its positions to out (float4 per vertex).
+// With stage_ns non-null, adds the nanoseconds spent in each Stage (a few clock reads
+// per substep; callers pass it for a sample of blocks only).
+using FrameFn = void (*)(const Block& block, const BlockParams& params, const Frame& frame, float* out,
+                         float* scratch, std::int64_t* stage_ns);
+
+// The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline
+// build. Both give the same bits.
+FrameFn frame_kernel();
+const char* frame_kernel_isa();
+// The baseline variant, for the tests that compare ISA variants.
+FrameFn frame_kernel_baseline();
+
+}  // namespace hairbench::kernels::han_soa

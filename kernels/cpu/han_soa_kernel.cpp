@@ -1,0 +1,472 @@
+// The fused block kernel of han_soa.h. This file is compiled once per ISA variant
+// (kernels/CMakeLists.txt), each time with HAN_SOA_VARIANT naming the namespace; the
+// loops over lanes are written plainly so the compiler turns each into vector
+// instructions of that variant.
+#include "kernels/cpu/han_soa.h"
+
+#include <chrono>
+#include <cmath>
+
+#ifndef HAN_SOA_VARIANT
+#error "HAN_SOA_VARIANT must name the ISA variant"
+#endif
+
+namespace hairbench::kernels::han_soa::HAN_SOA_VARIANT {
+
+namespace {
+
+constexpr int W = kLanes;
+
+#define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
+
+struct Quat {
+  float x[W], y[W], z[W], w[W];
+};
+
+// Eigen's quaternion product, in the order of its SSE kernel (quat_product<SSE>):
+// component by component (a·b_w - a' b') + (a'' b'' + a_w b), the w row negated.
+inline void quat_mul(const float* ax, const float* ay, const float* az, const float* aw, const float* bx,
+                     const float* by, const float* bz, const float* bw, Quat& r) {
+  LANES {
+    const float x = (ax[l] * bw[l] - az[l] * by[l]) + (ay[l] * bz[l] + aw[l] * bx[l]);
+    const float y = (ay[l] * bw[l] - ax[l] * bz[l]) + (az[l] * bx[l] + aw[l] * by[l]);
+    const float z = (az[l] * bw[l] - ay[l] * bx[l]) + (ax[l] * by[l] + aw[l] * bz[l]);
+    const float w = (aw[l] * bw[l] - ax[l] * bx[l]) - (az[l] * bz[l] + ay[l] * by[l]);
+    r.x[l] = x;
+    r.y[l] = y;
+    r.z[l] = z;
+    r.w[l] = w;
+  }
+}
+
+// Eigen's Quaternion::normalized(): coefficients (x, y, z, w) divided by the root of
+// (x² + z²) + (y² + w²) (its SSE horizontal sum), unchanged when that is 0.
+inline void quat_normalize(Quat& q) {
+  LANES {
+    const float n2 = (q.x[l] * q.x[l] + q.z[l] * q.z[l]) + (q.y[l] * q.y[l] + q.w[l] * q.w[l]);
+    const float r = std::sqrt(n2);
+    const bool ok = n2 > 0.0f;
+    q.x[l] = ok ? q.x[l] / r : q.x[l];
+    q.y[l] = ok ? q.y[l] / r : q.y[l];
+    q.z[l] = ok ? q.z[l] / r : q.z[l];
+    q.w[l] = ok ? q.w[l] / r : q.w[l];
+  }
+}
+
+// q · v in Eigen's form: uv = q×v, uv += uv, v + w uv + q×uv.
+inline void rotate(float qx, float qy, float qz, float qw, float vx, float vy, float vz, float& ox, float& oy,
+                   float& oz) {
+  float ux = qy * vz - qz * vy, uy = qz * vx - qx * vz, uz = qx * vy - qy * vx;
+  ux += ux;
+  uy += uy;
+  uz += uz;
+  ox = vx + qw * ux + (qy * uz - qz * uy);
+  oy = vy + qw * uy + (qz * ux - qx * uz);
+  oz = vz + qw * uz + (qx * uy - qy * ux);
+}
+
+// The frame of vertex i from its parent's frame and the edge (a, b): Algorithm 3, lines
+// 10-12, as kernels::child_frame (strand_kernels.cpp) with rotation_from_x (frames.h).
+inline void child_frame(const Quat& parent, const float* ax, const float* ay, const float* az, const float* bx,
+                        const float* by, const float* bz, Quat& out) {
+  Quat r;
+  alignas(64) float ok[W];
+  LANES {
+    const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
+    const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
+    ok[l] = len > 0.0f ? 1.0f : 0.0f;
+    float vx, vy, vz;  // parent^-1 · (edge / len): the conjugate's vector part is negated
+    rotate(-parent.x[l], -parent.y[l], -parent.z[l], parent.w[l], ex / len, ey / len, ez / len, vx, vy, vz);
+    // rotation_from_x(v): (1 + v_x, 0, -v_z, v_y) normalised; half a turn about z at v = -x.
+    const float w = 1.0f + vx;
+    const float n2 = (0.0f * 0.0f + vy * vy) + (vz * vz + w * w);
+    const float s = std::sqrt(n2);
+    const bool flip = w < 1e-6f;
+    r.x[l] = flip ? 0.0f : 0.0f / s;
+    r.y[l] = flip ? 0.0f : -vz / s;
+    r.z[l] = flip ? 1.0f : vy / s;
+    r.w[l] = flip ? 0.0f : w / s;
+  }
+  quat_mul(parent.x, parent.y, parent.z, parent.w, r.x, r.y, r.z, r.w, out);
+  quat_normalize(out);
+  LANES {
+    const bool keep = ok[l] == 0.0f;
+    out.x[l] = keep ? parent.x[l] : out.x[l];
+    out.y[l] = keep ? parent.y[l] : out.y[l];
+    out.z[l] = keep ? parent.z[l] : out.z[l];
+    out.w[l] = keep ? parent.w[l] : out.w[l];
+  }
+}
+
+// The local shape constraint of edge (a, b) towards goal (Eq. 4, local_shape_edge).
+inline void local_edge(float* __restrict ax, float* __restrict ay, float* __restrict az, const float* aw,
+                       float* __restrict bx, float* __restrict by, float* __restrict bz, const float* bw,
+                       const float* gx, const float* gy, const float* gz, float stiffness) {
+  LANES {
+    const float wsum = aw[l] + bw[l];
+    const bool on = wsum != 0.0f;
+    const float dx = stiffness * (gx[l] - bx[l]), dy = stiffness * (gy[l] - by[l]), dz = stiffness * (gz[l] - bz[l]);
+    const float ka = aw[l] / wsum, kb = bw[l] / wsum;
+    ax[l] = on ? ax[l] - dx * ka : ax[l];
+    ay[l] = on ? ay[l] - dy * ka : ay[l];
+    az[l] = on ? az[l] - dz * ka : az[l];
+    bx[l] = on ? bx[l] + dx * kb : bx[l];
+    by[l] = on ? by[l] + dy * kb : by[l];
+    bz[l] = on ? bz[l] + dz * kb : bz[l];
+  }
+}
+
+struct Rows {
+  float *px, *py, *pz, *qx, *qy, *qz;
+  const float *iw, *rx, *ry, *rz, *rl;
+};
+
+class Clock {
+ public:
+  explicit Clock(std::int64_t* ns) : ns_(ns) {
+    if (ns_) last_ = now();
+  }
+  void lap(Stage s) {
+    if (!ns_) return;
+    const std::int64_t t = now();
+    ns_[s] += t - last_;
+    last_ = t;
+  }
+
+ private:
+  static std::int64_t now() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  std::int64_t* ns_;
+  std::int64_t last_ = 0;
+};
+
+// Pinned vertices follow the head (follow_head), free ones are Verlet-integrated
+// (verlet_integrate); row by row, so the wind term sees vertex i-1 already moved, as in
+// the per-strand kernel.
+template <bool kWindy>
+void integrate(const Rows& r, int n, const Substep& s, [[maybe_unused]] const Frame& f, float keep) {
+  for (int i = 0; i < n; ++i) {
+    const int o = i * W;
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+    const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
+    if (i == 0) {  // the integrator starts at vertex 1; the root only follows the head
+      LANES {
+        const bool pinned = iw[l] == 0.0f;
+        const float x = px[l], y = py[l], z = pz[l];
+        px[l] = pinned ? s.t[0] + ((s.m[0] * rx[l] + s.m[1] * ry[l]) + s.m[2] * rz[l]) : x;
+        py[l] = pinned ? s.t[1] + ((s.m[3] * rx[l] + s.m[4] * ry[l]) + s.m[5] * rz[l]) : y;
+        pz[l] = pinned ? s.t[2] + ((s.m[6] * rx[l] + s.m[7] * ry[l]) + s.m[8] * rz[l]) : z;
+        qx[l] = pinned ? x : qx[l];
+        qy[l] = pinned ? y : qy[l];
+        qz[l] = pinned ? z : qz[l];
+      }
+      continue;
+    }
+    const float *ux = px - W, *uy = py - W, *uz = pz - W;  // vertex i-1, already moved
+    LANES {
+      const bool pinned = iw[l] == 0.0f;
+      const float gx = s.t[0] + ((s.m[0] * rx[l] + s.m[1] * ry[l]) + s.m[2] * rz[l]);
+      const float gy = s.t[1] + ((s.m[3] * rx[l] + s.m[4] * ry[l]) + s.m[5] * rz[l]);
+      const float gz = s.t[2] + ((s.m[6] * rx[l] + s.m[7] * ry[l]) + s.m[8] * rz[l]);
+      const float x = px[l], y = py[l], z = pz[l];
+      float adx, ady, adz;
+      if constexpr (kWindy) {
+        const float ex = x - ux[l], ey = y - uy[l], ez = z - uz[l];
+        const float len2 = ex * ex + (ey * ey + ez * ez);
+        const float len = std::sqrt(len2);
+        const bool has = len2 > 0.0f;
+        const float tx = has ? ex / len : 0.0f, ty = has ? ey / len : 0.0f, tz = has ? ez / len : 0.0f;
+        const float dot = f.wind[0] * tx + (f.wind[1] * ty + f.wind[2] * tz);
+        adx = (f.gravity[0] + (f.wind[0] - dot * tx)) * s.dt2;
+        ady = (f.gravity[1] + (f.wind[1] - dot * ty)) * s.dt2;
+        adz = (f.gravity[2] + (f.wind[2] - dot * tz)) * s.dt2;
+      } else {
+        adx = s.gravity_dt2[0];
+        ady = s.gravity_dt2[1];
+        adz = s.gravity_dt2[2];
+      }
+      px[l] = pinned ? gx : x + keep * (x - qx[l]) + adx;
+      py[l] = pinned ? gy : y + keep * (y - qy[l]) + ady;
+      pz[l] = pinned ? gz : z + keep * (z - qz[l]) + adz;
+      qx[l] = x;
+      qy[l] = y;
+      qz[l] = z;
+    }
+  }
+}
+
+// Eq. 2 (global_shape): free vertices below reach move towards T_H · P_i^0.
+void global_shape(const Rows& r, int n, const Substep& s, const BlockParams& p) {
+  for (int i = 0; i < n && static_cast<float>(i) < p.global_reach; ++i) {
+    const int o = i * W;
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
+    const float k = p.global_ramp ? p.global_stiffness * (1.0f - static_cast<float>(i) / p.global_reach)
+                                  : p.global_stiffness;
+    LANES {
+      const bool on = iw[l] != 0.0f;
+      const float gx = s.t[0] + ((s.m[0] * rx[l] + s.m[1] * ry[l]) + s.m[2] * rz[l]);
+      const float gy = s.t[1] + ((s.m[3] * rx[l] + s.m[4] * ry[l]) + s.m[5] * rz[l]);
+      const float gz = s.t[2] + ((s.m[6] * rx[l] + s.m[7] * ry[l]) + s.m[8] * rz[l]);
+      px[l] = on ? px[l] + k * (gx - px[l]) : px[l];
+      py[l] = on ? py[l] + k * (gy - py[l]) : py[l];
+      pz[l] = on ? pz[l] + k * (gz - pz[l]) : pz[l];
+    }
+  }
+}
+
+// Method 3 (Algorithm 5): the head-rotated rest edges, once per substep into scratch...
+void rest_edges_m3(const Rows& r, int n, const Substep& s, float* ex, float* ey, float* ez) {
+  for (int i = 2; i < n; ++i) {
+    const int o = i * W;
+    LANES {
+      rotate(s.q[0], s.q[1], s.q[2], s.q[3], r.rx[o + l] - r.rx[o + l - W], r.ry[o + l] - r.ry[o + l - W],
+             r.rz[o + l] - r.rz[o + l - W], ex[o + l], ey[o + l], ez[o + l]);
+    }
+  }
+}
+
+// ...then every iteration's goals are P_{i-1} + that edge, in even/odd batches (§5).
+void local_m3(const Rows& r, int n, const float* ex, const float* ey, const float* ez, float stiffness) {
+  alignas(64) float gx[W], gy[W], gz[W];
+  for (int first : {2, 3})
+    for (int i = first; i < n; i += 2) {
+      const int a = (i - 1) * W, b = i * W;
+      LANES {
+        gx[l] = r.px[a + l] + ex[b + l];
+        gy[l] = r.py[a + l] + ey[b + l];
+        gz[l] = r.pz[a + l] + ez[b + l];
+      }
+      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, gx, gy, gz,
+                 stiffness);
+    }
+}
+
+// Method 1 (Algorithm 3): serial root to tip, the frame rebuilt after every edge.
+void local_m1(const Rows& r, int n, const float* lx, const float* ly, const float* lz, const float* rest_frames,
+              const Substep& s, float stiffness) {
+  if (n < 3) return;
+  alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[W], gy[W], gz[W];
+  LANES {
+    hx[l] = s.q[0];
+    hy[l] = s.q[1];
+    hz[l] = s.q[2];
+    hw[l] = s.q[3];
+  }
+  const float* rr1 = rest_frames + 4 * W;  // w, x, y, z rows of wR_1^0
+  Quat frame, next;
+  quat_mul(hx, hy, hz, hw, rr1 + W, rr1 + 2 * W, rr1 + 3 * W, rr1, frame);
+  for (int i = 2; i < n; ++i) {
+    const int a = (i - 1) * W, b = i * W;
+    LANES {
+      float ox, oy, oz;
+      rotate(frame.x[l], frame.y[l], frame.z[l], frame.w[l], lx[b + l], ly[b + l], lz[b + l], ox, oy, oz);
+      gx[l] = r.px[a + l] + ox;
+      gy[l] = r.py[a + l] + oy;
+      gz[l] = r.pz[a + l] + oz;
+    }
+    local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, gx, gy, gz,
+               stiffness);
+    child_frame(frame, r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, next);
+    frame = next;
+  }
+}
+
+// Method 2 (Algorithm 4): goals from the previous iteration's frames (copied to
+// scratch), even/odd batches, then every frame rebuilt from its parent's old frame.
+void local_m2(const Rows& r, int n, const float* lx, const float* ly, const float* lz, const float* rest_frames,
+              float* ow, float* ox, float* oy, float* oz, float* scratch, const Substep& s, float stiffness) {
+  if (n < 3) return;
+  alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[W], gy[W], gz[W];
+  LANES {
+    hx[l] = s.q[0];
+    hy[l] = s.q[1];
+    hz[l] = s.q[2];
+    hw[l] = s.q[3];
+  }
+  for (int v = 0; v < 2; ++v) {
+    const float* rr = rest_frames + 4 * v * W;
+    Quat q;
+    quat_mul(hx, hy, hz, hw, rr + W, rr + 2 * W, rr + 3 * W, rr, q);
+    LANES {
+      ow[v * W + l] = q.w[l];
+      ox[v * W + l] = q.x[l];
+      oy[v * W + l] = q.y[l];
+      oz[v * W + l] = q.z[l];
+    }
+  }
+  const int nw = n * W;
+  float *sw = scratch, *sx = scratch + nw, *sy = scratch + 2 * nw, *sz = scratch + 3 * nw;
+  for (int j = 0; j < nw; ++j) {
+    sw[j] = ow[j];
+    sx[j] = ox[j];
+    sy[j] = oy[j];
+    sz[j] = oz[j];
+  }
+  for (int first : {2, 3})
+    for (int i = first; i < n; i += 2) {
+      const int a = (i - 1) * W, b = i * W;
+      LANES {
+        float tx, ty, tz;
+        rotate(sx[a + l], sy[a + l], sz[a + l], sw[a + l], lx[b + l], ly[b + l], lz[b + l], tx, ty, tz);
+        gx[l] = r.px[a + l] + tx;
+        gy[l] = r.py[a + l] + ty;
+        gz[l] = r.pz[a + l] + tz;
+      }
+      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, gx, gy, gz,
+                 stiffness);
+    }
+  Quat parent, out;
+  for (int i = 2; i < n; ++i) {
+    const int a = (i - 1) * W, b = i * W;
+    LANES {
+      parent.x[l] = sx[a + l];
+      parent.y[l] = sy[a + l];
+      parent.z[l] = sz[a + l];
+      parent.w[l] = sw[a + l];
+    }
+    child_frame(parent, r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, out);
+    LANES {
+      ow[b + l] = out.w[l];
+      ox[b + l] = out.x[l];
+      oy[b + l] = out.y[l];
+      oz[b + l] = out.z[l];
+    }
+  }
+}
+
+// Edge length constraints (edge_length) in even/odd batches.
+void edge_length(const Rows& r, int n) {
+  for (int first : {1, 2})
+    for (int i = first; i < n; i += 2) {
+      const int a = (i - 1) * W, b = i * W;
+      float *ax = r.px + a, *ay = r.py + a, *az = r.pz + a, *bx = r.px + b, *by = r.py + b, *bz = r.pz + b;
+      const float *aw = r.iw + a, *bw = r.iw + b, *rl = r.rl + b;
+      LANES {
+        const float wsum = aw[l] + bw[l];
+        const float dx = bx[l] - ax[l], dy = by[l] - ay[l], dz = bz[l] - az[l];
+        const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
+        const bool on = wsum != 0.0f && len > 0.0f;
+        const float k = (len - rl[l]) / (len * wsum);
+        const float cx = dx * k, cy = dy * k, cz = dz * k;
+        ax[l] = on ? ax[l] + aw[l] * cx : ax[l];
+        ay[l] = on ? ay[l] + aw[l] * cy : ay[l];
+        az[l] = on ? az[l] + aw[l] * cz : az[l];
+        bx[l] = on ? bx[l] - bw[l] * cx : bx[l];
+        by[l] = on ? by[l] - bw[l] * cy : by[l];
+        bz[l] = on ? bz[l] - bw[l] * cz : bz[l];
+      }
+    }
+}
+
+// Sphere collisions (collide_spheres): up to four passes; a lane whose pass moved
+// nothing would move nothing in later passes either, so passes stop when no lane moved.
+void collide(const Rows& r, int n, const Substep& s) {
+  constexpr int kPasses = 4;
+  for (int i = 0; i < n; ++i) {
+    const int o = i * W;
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    const float* iw = r.iw + o;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      int moved = 0;
+      for (int c = 0; c < s.sphere_count; ++c) {
+        const float cx = s.spheres[4 * c], cy = s.spheres[4 * c + 1], cz = s.spheres[4 * c + 2],
+                    cr = s.spheres[4 * c + 3];
+        int inside_any = 0;
+        LANES {
+          const float dx = px[l] - cx, dy = py[l] - cy, dz = pz[l] - cz;
+          const float d2 = dx * dx + (dy * dy + dz * dz);
+          inside_any |= (iw[l] != 0.0f && d2 < cr * cr) ? 1 : 0;
+        }
+        if (!inside_any) continue;
+        moved = 1;
+        LANES {
+          const float dx = px[l] - cx, dy = py[l] - cy, dz = pz[l] - cz;
+          const float d2 = dx * dx + (dy * dy + dz * dz);
+          const bool inside = iw[l] != 0.0f && d2 < cr * cr;
+          const float d = std::sqrt(d2);
+          const bool centre = !(d > 0.0f);
+          const float nx = centre ? 0.0f : dx / d, ny = centre ? 1.0f : dy / d, nz = centre ? 0.0f : dz / d;
+          px[l] = inside ? cx + nx * cr : px[l];
+          py[l] = inside ? cy + ny * cr : py[l];
+          pz[l] = inside ? cz + nz * cr : pz[l];
+        }
+      }
+      if (!moved) break;
+    }
+  }
+}
+
+void frame(const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
+           std::int64_t* stage_ns) {
+  const int n = b.n;
+  const std::size_t rows = static_cast<std::size_t>(n) * W;
+  float* d = b.data;
+  auto field = [&](int k) { return d + static_cast<std::size_t>(k) * rows; };
+  const Rows r{field(PX), field(PY), field(PZ), field(QX), field(QY), field(QZ),
+               field(IW), field(RX), field(RY), field(RZ), field(RL)};
+  const float* rest_frames = b.method == 3 ? nullptr : d + static_cast<std::size_t>(field_count(b.method)) * rows;
+  const bool local_on = p.local_iterations > 0;
+  const int iterations = p.local_iterations > p.length_iterations ? p.local_iterations : p.length_iterations;
+  Clock clock(stage_ns);
+  for (int k = 0; k < f.substep_count; ++k) {
+    const Substep& s = f.substeps[k];
+    if (f.windy)
+      integrate<true>(r, n, s, f, p.keep);
+    else
+      integrate<false>(r, n, s, f, p.keep);
+    clock.lap(kIntegrate);
+    if (p.global_on) {
+      global_shape(r, n, s, p);
+      clock.lap(kGlobal);
+    }
+    if (local_on && b.method == 3) {
+      rest_edges_m3(r, n, s, scratch, scratch + rows, scratch + 2 * rows);
+      clock.lap(kLocal);
+    }
+    // Algorithm 1 lines 7-9: local shape and edge length alternate, each up to its count.
+    for (int it = 0; it < iterations; ++it) {
+      if (it < p.local_iterations) {
+        switch (b.method) {
+          case 1:
+            local_m1(r, n, field(LX), field(LY), field(LZ), rest_frames, s, p.local_stiffness);
+            break;
+          case 2:
+            local_m2(r, n, field(LX), field(LY), field(LZ), rest_frames, field(OW), field(OX), field(OY), field(OZ),
+                     scratch, s, p.local_stiffness);
+            break;
+          default:
+            local_m3(r, n, scratch, scratch + rows, scratch + 2 * rows, p.local_stiffness);
+            break;
+        }
+        clock.lap(kLocal);
+      }
+      if (it < p.length_iterations) {
+        edge_length(r, n);
+        clock.lap(kLength);
+      }
+    }
+    if (s.sphere_count > 0) {
+      collide(r, n, s);
+      clock.lap(kCollision);
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    if (b.out_offset[l] == kNoStrand) continue;
+    float* o = out + 4 * static_cast<std::size_t>(b.out_offset[l]);
+    for (int i = 0; i < n; ++i) {
+      o[4 * i] = r.px[i * W + l];
+      o[4 * i + 1] = r.py[i * W + l];
+      o[4 * i + 2] = r.pz[i * W + l];
+      o[4 * i + 3] = r.iw[i * W + l];
+    }
+  }
+}
+
+}  // namespace
+
+FrameFn frame_fn() { return &frame; }
+
+}  // namespace hairbench::kernels::han_soa::HAN_SOA_VARIANT

@@ -1,0 +1,282 @@
+#include "models/han_fused/model.h"
+
+#include "core/parallel.h"
+#include "kernels/cpu/strand_kernels.h"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+
+namespace hairbench::han_fused {
+
+namespace soa = hairbench::kernels::han_soa;
+constexpr int W = soa::kLanes;
+
+// One block in this many (and the first block of every region) times its stages.
+constexpr std::size_t kSampleEvery = 16;
+
+HanFusedModel::HanFusedModel(han::Method method, const ModelContext& ctx)
+    : method_(method), ctx_(ctx), kernel_(soa::frame_kernel()) {}
+
+void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
+  const std::vector<float> rest_length = rest_edge_lengths(rest);
+  const std::size_t regions = rest.region_names.size();
+
+  // Per-region settings; a region's `method` (§6: a cheaper method as level of detail)
+  // overrides the model's own.
+  region_.clear();
+  std::vector<int> region_method;
+  bool any_frames = false;
+  for (std::size_t r = 0; r < regions; ++r) {
+    soa::BlockParams p{};
+    p.keep = 1.0f - static_cast<float>(params.get("damping", r));
+    p.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
+    const float range = static_cast<float>(params.get("global_range", r));
+    p.global_ramp = params.get_int("global_ramp", r) != 0;
+    p.global_on = p.global_stiffness != 0.0f && range != 0.0f;
+    p.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
+    p.local_iterations = p.local_stiffness != 0.0f ? params.get_int("local_iterations", r) : 0;
+    p.length_iterations = params.get_int("length_iterations", r);
+    // global_reach depends on the strand's vertex count: set per block below.
+    p.global_reach = range;
+    region_.push_back(p);
+    const int m = params.get_int("method", r);
+    region_method.push_back(m != 0 ? m : static_cast<int>(method_));
+    any_frames = any_frames || region_method.back() != 3;
+  }
+  substeps_ = params.get_int("substeps");
+
+  // Rest frames (Algorithm 2) with the per-strand kernel, for methods 1 and 2.
+  std::vector<Quatf> rest_rotation;
+  std::vector<Vec3f> rest_local;
+  if (any_frames) {
+    rest_rotation.assign(rest.vertex_count(), Quatf::Identity());
+    rest_local.assign(rest.vertex_count(), Vec3f::Zero());
+    for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+      const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
+      kernels::init_rest_frames(std::span(rest.positions).subspan(b, n), std::span(rest_rotation).subspan(b, n),
+                                std::span(rest_local).subspan(b, n));
+    }
+  }
+
+  // Blocks: strands of one region and one vertex count, kLanes at a time (ragged grooms
+  // give one partly filled block per (region, count); its idle lanes repeat a strand of
+  // the block and are never written back).
+  std::vector<std::uint32_t> order(rest.strand_count());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (rest.strand_region[a] != rest.strand_region[b]) return rest.strand_region[a] < rest.strand_region[b];
+    return rest.strand_size(a) < rest.strand_size(b);
+  });
+  blocks_.clear();
+  std::vector<std::array<std::uint32_t, W>> lanes;
+  std::size_t floats = 0;
+  for (std::size_t i = 0; i < order.size();) {
+    const std::uint16_t region = rest.strand_region[order[i]];
+    const int n = static_cast<int>(rest.strand_size(order[i]));
+    std::size_t j = i;
+    while (j < order.size() && j - i < static_cast<std::size_t>(W) && rest.strand_region[order[j]] == region &&
+           static_cast<int>(rest.strand_size(order[j])) == n)
+      ++j;
+    BlockInfo b{};
+    b.offset = floats;
+    b.n = n;
+    b.method = region_method[region];
+    b.region = region;
+    b.sampled = blocks_.size() % kSampleEvery == 0 || blocks_.empty() || blocks_.back().region != region;
+    std::array<std::uint32_t, W> strands{};
+    for (int l = 0; l < W; ++l) {
+      const bool used = i + static_cast<std::size_t>(l) < j;
+      strands[l] = order[used ? i + l : j - 1];
+      b.out_offset[l] = used ? rest.strand_begin(strands[l]) : soa::kNoStrand;
+    }
+    floats += soa::block_floats(b.method, n);
+    blocks_.push_back(b);
+    lanes.push_back(strands);
+    i = j;
+  }
+
+  data_.assign(floats, 0.0f);
+  int max_n = 0;
+  any_global_ = any_local_ = any_length_ = false;
+  for (std::size_t k = 0; k < blocks_.size(); ++k) {
+    const BlockInfo& b = blocks_[k];
+    const soa::BlockParams& p = region_[b.region];
+    any_global_ = any_global_ || p.global_on;
+    any_local_ = any_local_ || p.local_iterations > 0;
+    any_length_ = any_length_ || p.length_iterations > 0;
+    max_n = std::max(max_n, b.n);
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    float* d = data_.data() + b.offset;
+    auto at = [&](int field, int i, int l) -> float& { return d[field * rows + static_cast<std::size_t>(i) * W + l]; };
+    for (int l = 0; l < W; ++l) {
+      const std::size_t v0 = rest.strand_begin(lanes[k][l]);
+      for (int i = 0; i < b.n; ++i) {
+        const Vec4f& p0 = rest.positions[v0 + i];
+        for (int c = 0; c < 3; ++c) {
+          at(soa::PX + c, i, l) = p0[c];
+          at(soa::QX + c, i, l) = p0[c];
+          at(soa::RX + c, i, l) = p0[c];
+        }
+        at(soa::IW, i, l) = p0.w();
+        at(soa::RL, i, l) = rest_length[v0 + i];
+        if (b.method == 3) continue;
+        for (int c = 0; c < 3; ++c) at(soa::LX + c, i, l) = rest_local[v0 + i][c];
+        if (b.method == 2) {  // method 2's frames start at the rest frames
+          const Quatf& q = rest_rotation[v0 + i];
+          at(soa::OW, i, l) = q.w();
+          at(soa::OX, i, l) = q.x();
+          at(soa::OY, i, l) = q.y();
+          at(soa::OZ, i, l) = q.z();
+        }
+      }
+      if (b.method != 3) {
+        float* frames = d + static_cast<std::size_t>(soa::field_count(b.method)) * rows;
+        for (int v = 0; v < 2; ++v) {
+          const Quatf& q = rest_rotation[v0 + static_cast<std::size_t>(v)];
+          frames[(4 * v + 0) * W + l] = q.w();
+          frames[(4 * v + 1) * W + l] = q.x();
+          frames[(4 * v + 2) * W + l] = q.y();
+          frames[(4 * v + 3) * W + l] = q.z();
+        }
+      }
+    }
+  }
+  pos_ = rest.positions;
+
+  // Static partition of the blocks over the threads by estimated cost (vertices times
+  // passes over them), fixed at reset: which thread runs a block never changes a bit of
+  // its result, so any thread count gives the same state.
+  const int threads = ctx_.pool ? ctx_.pool->threads() : 1;
+  std::vector<double> cost(blocks_.size());
+  double total = 0.0;
+  for (std::size_t k = 0; k < blocks_.size(); ++k) {
+    const BlockInfo& b = blocks_[k];
+    const soa::BlockParams& p = region_[b.region];
+    const double local_cost = b.method == 1 ? 8.0 : b.method == 2 ? 7.0 : 1.0;
+    cost[k] = b.n * (3.0 + local_cost * p.local_iterations + p.length_iterations);
+    total += cost[k];
+  }
+  threads_.assign(static_cast<std::size_t>(threads), ThreadState{});
+  double acc = 0.0;
+  std::size_t k = 0;
+  for (int t = 0; t < threads; ++t) {
+    threads_[t].first = k;
+    const double end = total * (t + 1) / threads;
+    while (k < blocks_.size() && (t == threads - 1 || acc + 0.5 * cost[k] < end)) acc += cost[k++];
+    threads_[t].last = k;
+  }
+  scratch_stride_ = soa::scratch_floats(max_n);
+  scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
+  substep_.assign(static_cast<std::size_t>(substeps_), soa::Substep{});
+  spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
+}
+
+std::size_t HanFusedModel::state_bytes() const {
+  return data_.size() * sizeof(float) + pos_.size() * sizeof(Vec4f);
+}
+
+void HanFusedModel::run_thread(int t) {
+  ThreadState& ts = threads_[static_cast<std::size_t>(t)];
+  float* out = pos_.data()->data();
+  float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
+  for (std::size_t k = ts.first; k < ts.last; ++k) {
+    const BlockInfo& b = blocks_[k];
+    soa::BlockParams p = region_[b.region];
+    p.global_reach = p.global_reach * static_cast<float>(b.n);  // range · n, as global_shape
+    const soa::Block block{data_.data() + b.offset, b.n, b.method, b.out_offset.data()};
+    if (!b.sampled) {
+      kernel_(block, p, frame_, out, scratch, nullptr);
+      continue;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    kernel_(block, p, frame_, out, scratch, ts.stage_ns.data());
+    ts.sampled_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start)
+                         .count();
+  }
+}
+
+void HanFusedModel::step(const FrameInput& in, StageTimes& times) {
+  const auto start = std::chrono::steady_clock::now();
+  const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const std::size_t nc = in.colliders.size();
+  // Grows only when a scene has more colliders than any before (reserved for 16).
+  if (spheres_.size() < nc * 4 * substep_.size()) spheres_.resize(nc * 4 * substep_.size());
+  for (int k = 1; k <= substeps_; ++k) {
+    const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(k) / static_cast<float>(substeps_));
+    const Quatf q(head.rotation());
+    soa::Substep& s = substep_[static_cast<std::size_t>(k - 1)];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) s.m[3 * r + c] = head.linear()(r, c);
+      s.t[r] = head.translation()[r];
+    }
+    s.q[0] = q.x();
+    s.q[1] = q.y();
+    s.q[2] = q.z();
+    s.q[3] = q.w();
+    s.dt2 = dt * dt;
+    const Vec3f gdt2 = in.gravity * s.dt2;
+    for (int c = 0; c < 3; ++c) s.gravity_dt2[c] = gdt2[c];
+    float* sp = spheres_.data() + static_cast<std::size_t>(k - 1) * nc * 4;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const Vec3f center = collider_center(in.colliders[c], head);
+      sp[4 * c] = center.x();
+      sp[4 * c + 1] = center.y();
+      sp[4 * c + 2] = center.z();
+      sp[4 * c + 3] = in.colliders[c].radius;
+    }
+    s.spheres = sp;
+    s.sphere_count = static_cast<int>(nc);
+  }
+  frame_.substeps = substep_.data();
+  frame_.substep_count = substeps_;
+  const Vec3f wind = in.wind.acceleration();
+  for (int c = 0; c < 3; ++c) {
+    frame_.gravity[c] = in.gravity[c];
+    frame_.wind[c] = wind[c];
+  }
+  frame_.windy = in.wind.active();  // no wind, no wind term
+
+  for (ThreadState& ts : threads_) {
+    ts.stage_ns.fill(0);
+    ts.sampled_ns = 0;
+  }
+  HanFusedModel* self = this;  // one pointer: the std::function stores it without allocating
+  if (ctx_.pool)
+    ctx_.pool->parallel_for(threads_.size(), [self](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) self->run_thread(static_cast<int>(t));
+    });
+  else
+    run_thread(0);
+
+  // Per-stage times without a clock read per stage per block: the sampled blocks (one in
+  // kSampleEvery, and each region's first) time their stages; each stage's share of
+  // their time, times the step's wall time, is the stage's time. What the shares leave
+  // (write-back of the positions, waiting for the other thread) stays untimed.
+  const double wall_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::array<std::int64_t, soa::kStageCount> ns{};
+  std::int64_t sampled = 0;
+  for (const ThreadState& ts : threads_) {
+    for (int s = 0; s < soa::kStageCount; ++s) ns[s] += ts.stage_ns[s];
+    sampled += ts.sampled_ns;
+  }
+  auto report = [&](std::string_view name, soa::Stage s, bool ran) {
+    if (!ran) {
+      times.skip(name);
+      return;
+    }
+    times.add(name, sampled > 0 ? wall_ms * static_cast<double>(ns[s]) / static_cast<double>(sampled) : 0.0);
+  };
+  report("integrate", soa::kIntegrate, true);
+  report("global_shape", soa::kGlobal, any_global_);
+  report("local_shape", soa::kLocal, any_local_);
+  report("length", soa::kLength, any_length_);
+  report("collision", soa::kCollision, nc > 0);
+}
+
+std::unique_ptr<HairModel> make(han::Method method, const ModelContext& ctx) {
+  return std::make_unique<HanFusedModel>(method, ctx);
+}
+
+}  // namespace hairbench::han_fused

@@ -1,0 +1,207 @@
+// The fused structure-of-arrays Han & Harada models (han_m1..3, models/han_fused) against
+// the per-stage reference implementation (han_m*_ref, models/han): the fused kernel
+// performs every strand's floating-point operations in the reference's order, so the
+// states must agree bit for bit, frame after frame, on every groom shape (equal and
+// ragged vertex counts, several regions), with and without wind, colliders and the
+// stages a region switches off; and the state must not depend on the thread count or
+// on the ISA variant of the kernel.
+#include "test_support.h"
+
+#include "core/parallel.h"
+#include "kernels/cpu/han_soa.h"
+#include "models/han/model.h"
+#include "models/han_fused/model.h"
+#include "models/registry.h"
+#include "reports/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+namespace hairbench {
+namespace {
+
+Scenario paper_model1(std::size_t keep_every) {
+  Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_PAPER_SCENARIO_DIR) / "han2012_model1.json");
+  sc.groom = every_nth_strand(sc.groom, keep_every);
+  return sc;
+}
+
+std::unique_ptr<HairModel> make(const std::string& name, const Scenario& sc, const std::vector<ParamOverride>& ov,
+                                ThreadPool& pool) {
+  const ModelInfo* info = find_model(name);
+  if (!info) throw std::runtime_error("no model " + name);
+  return make_model(*info, sc, resolve_params(*info, sc, ov), pool);
+}
+
+// Steps two models in lockstep; the first frame whose positions differ in any bit, or
+// -1. `max_diff` gets the largest coordinate difference over all frames.
+int first_difference(const Scenario& sc, const std::string& a, const std::string& b, int frames,
+                     const std::vector<ParamOverride>& ov, double* max_diff = nullptr) {
+  ThreadPool pool(2);
+  auto ma = make(a, sc, ov, pool);
+  auto mb = make(b, sc, ov, pool);
+  int first = -1;
+  double worst = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    const FrameInput in = frame_input(sc, f);
+    StageTimes t;
+    ma->step(in, t);
+    mb->step(in, t);
+    const auto pa = ma->positions(), pb = mb->positions();
+    if (first < 0 && std::memcmp(pa.data(), pb.data(), pa.size_bytes()) != 0) first = f;
+    for (std::size_t i = 0; i < pa.size(); ++i) worst = std::max(worst, double((pa[i] - pb[i]).cwiseAbs().maxCoeff()));
+  }
+  if (max_diff) *max_diff = worst;
+  return first;
+}
+
+const std::vector<std::string> kMethods = {"han_m1", "han_m2", "han_m3"};
+
+TEST(HanFused, BitIdenticalToReferenceOnShake) {
+  const Scenario sc = test::builtin("shake", 8);
+  for (const std::string& m : kMethods) {
+    double diff = 0.0;
+    EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}, &diff), -1) << m << " max diff " << diff;
+  }
+}
+
+TEST(HanFused, BitIdenticalToReferenceOnPonytailWithPaperSetting) {
+  const Scenario sc = test::builtin("ponytail", 8);
+  for (const std::string& m : kMethods) {
+    double diff = 0.0;
+    EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, test::paper_setting(), &diff), -1)
+        << m << " max diff " << diff;
+  }
+}
+
+TEST(HanFused, BitIdenticalToReferenceInWind) {
+  const Scenario sc = test::builtin("wind_gust", 16);
+  for (const std::string& m : kMethods) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
+}
+
+// The Table 1 model-1 groom: three regions, ragged vertex counts (partly filled blocks),
+// three colliders.
+TEST(HanFused, BitIdenticalToReferenceOnRaggedPaperGroom) {
+  const Scenario sc = paper_model1(16);
+  std::set<std::uint32_t> sizes;
+  for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) sizes.insert(sc.groom.strand_size(s));
+  ASSERT_GT(sizes.size(), 1u) << "the groom should be ragged";
+  for (const std::string& m : kMethods) EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, {}), -1) << m;
+}
+
+// Stages switched off by parameters give the same bits as running them with no effect.
+TEST(HanFused, BitIdenticalWithStagesOff) {
+  const Scenario sc = test::builtin("shake", 16);
+  const std::vector<std::vector<ParamOverride>> settings = {
+      {{"*", "global_stiffness", 0.0}},
+      {{"*", "global_range", 0.0}},
+      {{"*", "local_iterations", 0}},
+      {{"*", "length_iterations", 0}, {"*", "local_iterations", 4}},
+  };
+  for (const auto& ov : settings)
+    for (const std::string& m : kMethods)
+      EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, ov), -1) << m << " " << ov[0].name;
+}
+
+// method = 1..3 in every region runs that method whatever the model's own (§6 LOD).
+TEST(HanFused, MethodParameterSelectsTheMethod) {
+  const Scenario sc = test::builtin("shake", 16);
+  EXPECT_EQ(first_difference(sc, "han_m3", "han_m1_ref", 60, {{"han_m3", "method", 1}}), -1);
+  EXPECT_EQ(first_difference(sc, "han_m1", "han_m2_ref", 60, {{"han_m1", "method", 2}}), -1);
+  EXPECT_EQ(first_difference(sc, "han_m2", "han_m3_ref", 60, {{"han_m2", "method", 3}}), -1);
+}
+
+// Per-region methods: each region's strands follow their own method, as if the whole
+// groom ran it (strands are independent).
+TEST(HanFused, PerRegionMethod) {
+  const Scenario sc = paper_model1(16);
+  ASSERT_GE(sc.groom.region_names.size(), 2u);
+  ThreadPool pool(2);
+  const ModelInfo* info = find_model("han_m1");
+  ParamSet mixed = resolve_params(*info, sc, {});
+  mixed.set_region(1, "method", 3, {"test", ""});
+  han_fused::HanFusedModel fast(han::Method::Serial, ModelContext{&pool});
+  fast.reset(sc.groom, mixed);
+  auto m1 = make("han_m1_ref", sc, {}, pool);
+  auto m3 = make("han_m3_ref", sc, {}, pool);
+  for (int f = 0; f < 30; ++f) {
+    const FrameInput in = frame_input(sc, f);
+    StageTimes t;
+    fast.step(in, t);
+    m1->step(in, t);
+    m3->step(in, t);
+  }
+  std::size_t checked[2] = {0, 0};
+  for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) {
+    const bool tail = sc.groom.strand_region[s] == 1;
+    const auto expect = tail ? m3->positions() : m1->positions();
+    for (std::size_t v = sc.groom.strand_begin(s); v < sc.groom.strand_offsets[s + 1]; ++v)
+      ASSERT_EQ(std::memcmp(&fast.positions()[v], &expect[v], sizeof(Vec4f)), 0) << "strand " << s;
+    ++checked[tail ? 1 : 0];
+  }
+  EXPECT_GT(checked[0], 0u);
+  EXPECT_GT(checked[1], 0u);
+}
+
+std::uint64_t state_hash_after(const Scenario& sc, const std::string& model, int threads, int frames) {
+  ThreadPool pool(threads);
+  auto m = make(model, sc, {}, pool);
+  for (int f = 0; f < frames; ++f) {
+    StageTimes t;
+    m->step(frame_input(sc, f), t);
+  }
+  return metrics::state_hash(m->positions());
+}
+
+TEST(HanFused, StateHashIndependentOfThreadCount) {
+  const Scenario sc = paper_model1(8);
+  for (const std::string& m : kMethods) {
+    const auto one = state_hash_after(sc, m, 1, 20);
+    EXPECT_EQ(one, state_hash_after(sc, m, 2, 20)) << m;
+    EXPECT_EQ(one, state_hash_after(sc, m, 3, 20)) << m;
+  }
+}
+
+TEST(HanFused, IsaVariantsGiveTheSameBits) {
+  const Scenario sc = paper_model1(16);
+  ThreadPool pool(2);
+  for (han::Method method : {han::Method::Serial, han::Method::Jacobi, han::Method::RestFrames}) {
+    const ParamSet params = resolve_params(*find_model("han_m1"), sc, {});
+    han_fused::HanFusedModel best(method, ModelContext{&pool}), base(method, ModelContext{&pool});
+    base.use_kernel(kernels::han_soa::frame_kernel_baseline());
+    best.reset(sc.groom, params);
+    base.reset(sc.groom, params);
+    for (int f = 0; f < 30; ++f) {
+      StageTimes t;
+      best.step(frame_input(sc, f), t);
+      base.step(frame_input(sc, f), t);
+    }
+    EXPECT_EQ(metrics::state_hash(best.positions()), metrics::state_hash(base.positions()))
+        << kernels::han_soa::frame_kernel_isa();
+  }
+}
+
+// Stages the scene does not need are reported skipped, the others with a time.
+TEST(HanFused, SkippedStagesAreReported) {
+  Scenario sc = test::builtin("shake", 16);
+  ThreadPool pool(2);
+  auto m = make("han_m3", sc, {{"*", "global_stiffness", 0.0}}, pool);
+  FrameInput in = frame_input(sc, 0);
+  in.colliders = {};
+  StageTimes t;
+  m->step(in, t);
+  std::map<std::string, bool> skipped;
+  for (const auto& e : t.entries()) skipped[std::string(e.name)] = e.skipped;
+  EXPECT_EQ(skipped, (std::map<std::string, bool>{{"integrate", false},
+                                                   {"global_shape", true},
+                                                   {"local_shape", false},
+                                                   {"length", false},
+                                                   {"collision", true}}));
+}
+
+}  // namespace
+}  // namespace hairbench
