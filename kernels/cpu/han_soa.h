@@ -46,14 +46,19 @@ inline constexpr std::size_t block_floats(int method, int n) {
   return static_cast<std::size_t>(field_count(method) * n + (method == 3 ? 0 : kRestFrameRows)) * kLanes;
 }
 // Floats of per-thread scratch a block of n vertices needs (method 3's head-rotated rest
-// edges, method 2's copy of the frames).
-inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(4 * n) * kLanes; }
+// edges or method 2's copy of the frames, and the local constraint's mass weights).
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(6 * n) * kLanes; }
+
+// What a row (one vertex of every lane) holds: free and pinned vertices need different
+// work, and most rows are all one or the other.
+enum RowKind : std::uint8_t { kRowFree, kRowPinned, kRowMixed };
 
 struct Block {
   float* data;                      // block_floats(method, n) floats
   int n;                            // vertices per strand
   int method;                       // 1, 2 or 3 (Han & Harada §4.2)
   const std::uint32_t* out_offset;  // per lane: first vertex in the float4 output, or kNoStrand
+  const RowKind* rows;              // n entries
 };
 
 // Per-region solver settings, with the stages a region does not need switched off.
@@ -87,10 +92,14 @@ struct Frame {
 
 enum Stage : int { kIntegrate, kGlobal, kLocal, kLength, kCollision, kStageCount };
 
-// Advances one block by one frame and writes its positions to out (float4 per vertex).
-// With stage_ns non-null, adds the nanoseconds spent in each Stage (a few clock reads
-// per substep; callers pass it for a sample of blocks only).
-using FrameFn = void (*)(const Block& block, const BlockParams& params, const Frame& frame, float* out,
+// Advances `count` (1..kMaxBlocks) blocks of one vertex count, method and parameter set
+// by one frame, side by side, and writes their positions to out (float4 per vertex).
+// Two blocks at a time give method 1's serial chains something to overlap with; scratch
+// holds count * scratch_floats(n) floats. With stage_ns non-null, adds the nanoseconds
+// spent in each Stage (a few clock reads per substep; callers pass it for a sample of
+// blocks only).
+inline constexpr int kMaxBlocks = 2;
+using FrameFn = void (*)(const Block* blocks, int count, const BlockParams& params, const Frame& frame, float* out,
                          float* scratch, std::int64_t* stage_ns);
 
 // The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline

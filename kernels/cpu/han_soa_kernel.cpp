@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #ifndef HAN_SOA_VARIANT
 #error "HAN_SOA_VARIANT must name the ISA variant"
@@ -99,22 +100,34 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
 }
 
 // The local shape constraint of edge (a, b) towards goal (Eq. 4, local_shape_edge).
+// ka, kb: the edge's mass weights (mass_weights).
 inline void local_edge(float* __restrict ax, float* __restrict ay, float* __restrict az, const float* aw,
                        float* __restrict bx, float* __restrict by, float* __restrict bz, const float* bw,
-                       const float* gx, const float* gy, const float* gz, float stiffness) {
+                       const float* ka, const float* kb, const float* gx, const float* gy, const float* gz,
+                       float stiffness) {
   LANES {
-    const float wsum = aw[l] + bw[l];
-    const bool on = wsum != 0.0f;
+    const bool on = aw[l] + bw[l] != 0.0f;
     const float dx = stiffness * (gx[l] - bx[l]), dy = stiffness * (gy[l] - by[l]), dz = stiffness * (gz[l] - bz[l]);
-    const float ka = aw[l] / wsum, kb = bw[l] / wsum;
-    ax[l] = on ? ax[l] - dx * ka : ax[l];
-    ay[l] = on ? ay[l] - dy * ka : ay[l];
-    az[l] = on ? az[l] - dz * ka : az[l];
-    bx[l] = on ? bx[l] + dx * kb : bx[l];
-    by[l] = on ? by[l] + dy * kb : by[l];
-    bz[l] = on ? bz[l] + dz * kb : bz[l];
+    ax[l] = on ? ax[l] - dx * ka[l] : ax[l];
+    ay[l] = on ? ay[l] - dy * ka[l] : ay[l];
+    az[l] = on ? az[l] - dz * ka[l] : az[l];
+    bx[l] = on ? bx[l] + dx * kb[l] : bx[l];
+    by[l] = on ? by[l] + dy * kb[l] : by[l];
+    bz[l] = on ? bz[l] + dz * kb[l] : bz[l];
   }
 }
+
+// The head transform in locals (no aliasing with the rows for the vectoriser), applied
+// as Eigen evaluates Affine3f · Vector3f: t + ((m00 x + m01 y) + m02 z).
+struct Pose {
+  float m0, m1, m2, m3, m4, m5, m6, m7, m8, t0, t1, t2;
+  explicit Pose(const Substep& s)
+      : m0(s.m[0]), m1(s.m[1]), m2(s.m[2]), m3(s.m[3]), m4(s.m[4]), m5(s.m[5]), m6(s.m[6]), m7(s.m[7]),
+        m8(s.m[8]), t0(s.t[0]), t1(s.t[1]), t2(s.t[2]) {}
+  float x(float a, float b, float c) const { return t0 + ((m0 * a + m1 * b) + m2 * c); }
+  float y(float a, float b, float c) const { return t1 + ((m3 * a + m4 * b) + m5 * c); }
+  float z(float a, float b, float c) const { return t2 + ((m6 * a + m7 * b) + m8 * c); }
+};
 
 struct Rows {
   float *px, *py, *pz, *qx, *qy, *qz;
@@ -145,74 +158,132 @@ class Clock {
 // Pinned vertices follow the head (follow_head), free ones are Verlet-integrated
 // (verlet_integrate); row by row, so the wind term sees vertex i-1 already moved, as in
 // the per-strand kernel.
-template <bool kWindy>
-void integrate(const Rows& r, int n, const Substep& s, [[maybe_unused]] const Frame& f, float keep) {
-  for (int i = 0; i < n; ++i) {
-    const int o = i * W;
-    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
-    const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
-    if (i == 0) {  // the integrator starts at vertex 1; the root only follows the head
-      LANES {
-        const bool pinned = iw[l] == 0.0f;
-        const float x = px[l], y = py[l], z = pz[l];
-        px[l] = pinned ? s.t[0] + ((s.m[0] * rx[l] + s.m[1] * ry[l]) + s.m[2] * rz[l]) : x;
-        py[l] = pinned ? s.t[1] + ((s.m[3] * rx[l] + s.m[4] * ry[l]) + s.m[5] * rz[l]) : y;
-        pz[l] = pinned ? s.t[2] + ((s.m[6] * rx[l] + s.m[7] * ry[l]) + s.m[8] * rz[l]) : z;
-        qx[l] = pinned ? x : qx[l];
-        qy[l] = pinned ? y : qy[l];
-        qz[l] = pinned ? z : qz[l];
-      }
-      continue;
-    }
-    const float *ux = px - W, *uy = py - W, *uz = pz - W;  // vertex i-1, already moved
+template <bool kWindy, RowKind kKind>
+inline void integrate_row(const Rows& r, int i, const Pose& h, const Substep& s, const Frame& f, float keep) {
+  const int o = i * W;
+  float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+  const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
+  if constexpr (kKind == kRowPinned) {
     LANES {
-      const bool pinned = iw[l] == 0.0f;
-      const float gx = s.t[0] + ((s.m[0] * rx[l] + s.m[1] * ry[l]) + s.m[2] * rz[l]);
-      const float gy = s.t[1] + ((s.m[3] * rx[l] + s.m[4] * ry[l]) + s.m[5] * rz[l]);
-      const float gz = s.t[2] + ((s.m[6] * rx[l] + s.m[7] * ry[l]) + s.m[8] * rz[l]);
       const float x = px[l], y = py[l], z = pz[l];
-      float adx, ady, adz;
-      if constexpr (kWindy) {
-        const float ex = x - ux[l], ey = y - uy[l], ez = z - uz[l];
-        const float len2 = ex * ex + (ey * ey + ez * ez);
-        const float len = std::sqrt(len2);
-        const bool has = len2 > 0.0f;
-        const float tx = has ? ex / len : 0.0f, ty = has ? ey / len : 0.0f, tz = has ? ez / len : 0.0f;
-        const float dot = f.wind[0] * tx + (f.wind[1] * ty + f.wind[2] * tz);
-        adx = (f.gravity[0] + (f.wind[0] - dot * tx)) * s.dt2;
-        ady = (f.gravity[1] + (f.wind[1] - dot * ty)) * s.dt2;
-        adz = (f.gravity[2] + (f.wind[2] - dot * tz)) * s.dt2;
-      } else {
-        adx = s.gravity_dt2[0];
-        ady = s.gravity_dt2[1];
-        adz = s.gravity_dt2[2];
-      }
-      px[l] = pinned ? gx : x + keep * (x - qx[l]) + adx;
-      py[l] = pinned ? gy : y + keep * (y - qy[l]) + ady;
-      pz[l] = pinned ? gz : z + keep * (z - qz[l]) + adz;
+      px[l] = h.x(rx[l], ry[l], rz[l]);
+      py[l] = h.y(rx[l], ry[l], rz[l]);
+      pz[l] = h.z(rx[l], ry[l], rz[l]);
       qx[l] = x;
       qy[l] = y;
       qz[l] = z;
+    }
+    return;
+  }
+  const bool root = i == 0;  // the integrator starts at vertex 1; the root only follows the head
+  if (root && kKind == kRowFree) return;
+  const float *ux = px - W, *uy = py - W, *uz = pz - W;  // vertex i-1, already moved
+  const float gdx = s.gravity_dt2[0], gdy = s.gravity_dt2[1], gdz = s.gravity_dt2[2];
+  [[maybe_unused]] const float dt2 = s.dt2, grx = f.gravity[0], gry = f.gravity[1], grz = f.gravity[2],
+                               wx = f.wind[0], wy = f.wind[1], wz = f.wind[2];
+  if (root) {  // a mixed root row: its pinned lanes follow, its free lanes stay
+    LANES {
+      const bool pinned = iw[l] == 0.0f;
+      const float x = px[l], y = py[l], z = pz[l];
+      const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
+      px[l] = pinned ? gx : x;
+      py[l] = pinned ? gy : y;
+      pz[l] = pinned ? gz : z;
+      qx[l] = pinned ? x : qx[l];
+      qy[l] = pinned ? y : qy[l];
+      qz[l] = pinned ? z : qz[l];
+    }
+    return;
+  }
+  LANES {
+    const float x = px[l], y = py[l], z = pz[l];
+    float adx, ady, adz;
+    if constexpr (kWindy) {
+      const float ex = x - ux[l], ey = y - uy[l], ez = z - uz[l];
+      const float len2 = ex * ex + (ey * ey + ez * ez);
+      const float len = std::sqrt(len2);
+      const bool has = len2 > 0.0f;
+      const float tx = has ? ex / len : 0.0f, ty = has ? ey / len : 0.0f, tz = has ? ez / len : 0.0f;
+      const float dot = wx * tx + (wy * ty + wz * tz);
+      adx = (grx + (wx - dot * tx)) * dt2;
+      ady = (gry + (wy - dot * ty)) * dt2;
+      adz = (grz + (wz - dot * tz)) * dt2;
+    } else {
+      adx = gdx;
+      ady = gdy;
+      adz = gdz;
+    }
+    const float nx = x + keep * (x - qx[l]) + adx;
+    const float ny = y + keep * (y - qy[l]) + ady;
+    const float nz = z + keep * (z - qz[l]) + adz;
+    if constexpr (kKind == kRowMixed) {
+      const bool pinned = iw[l] == 0.0f;
+      px[l] = pinned ? h.x(rx[l], ry[l], rz[l]) : nx;
+      py[l] = pinned ? h.y(rx[l], ry[l], rz[l]) : ny;
+      pz[l] = pinned ? h.z(rx[l], ry[l], rz[l]) : nz;
+    } else {
+      px[l] = nx;
+      py[l] = ny;
+      pz[l] = nz;
+    }
+    qx[l] = x;
+    qy[l] = y;
+    qz[l] = z;
+  }
+}
+
+// Pinned vertices follow the head (follow_head), free ones are Verlet-integrated
+// (verlet_integrate); row by row, so the wind term sees vertex i-1 already moved, as in
+// the per-strand kernel.
+template <bool kWindy>
+void integrate(const Rows& r, const RowKind* kinds, int n, const Substep& s, const Frame& f, float keep) {
+  const Pose h(s);
+  for (int i = 0; i < n; ++i) {
+    switch (kinds[i]) {
+      case kRowFree:
+        integrate_row<kWindy, kRowFree>(r, i, h, s, f, keep);
+        break;
+      case kRowPinned:
+        integrate_row<kWindy, kRowPinned>(r, i, h, s, f, keep);
+        break;
+      default:
+        integrate_row<kWindy, kRowMixed>(r, i, h, s, f, keep);
+        break;
     }
   }
 }
 
 // Eq. 2 (global_shape): free vertices below reach move towards T_H · P_i^0.
-void global_shape(const Rows& r, int n, const Substep& s, const BlockParams& p) {
+void global_shape(const Rows& r, const RowKind* kinds, int n, const Substep& s, const BlockParams& p) {
+  const Pose h(s);
   for (int i = 0; i < n && static_cast<float>(i) < p.global_reach; ++i) {
+    if (kinds[i] == kRowPinned) continue;
     const int o = i * W;
     float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
     const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
     const float k = p.global_ramp ? p.global_stiffness * (1.0f - static_cast<float>(i) / p.global_reach)
                                   : p.global_stiffness;
+    const bool mixed = kinds[i] == kRowMixed;
     LANES {
-      const bool on = iw[l] != 0.0f;
-      const float gx = s.t[0] + ((s.m[0] * rx[l] + s.m[1] * ry[l]) + s.m[2] * rz[l]);
-      const float gy = s.t[1] + ((s.m[3] * rx[l] + s.m[4] * ry[l]) + s.m[5] * rz[l]);
-      const float gz = s.t[2] + ((s.m[6] * rx[l] + s.m[7] * ry[l]) + s.m[8] * rz[l]);
+      const bool on = !mixed || iw[l] != 0.0f;
+      const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
       px[l] = on ? px[l] + k * (gx - px[l]) : px[l];
       py[l] = on ? py[l] + k * (gy - py[l]) : py[l];
       pz[l] = on ? pz[l] + k * (gz - pz[l]) : pz[l];
+    }
+  }
+}
+
+// The local constraint's mass weights w_{i-1}/(w_{i-1}+w_i) and w_i/(w_{i-1}+w_i) of
+// every edge: constant, so divided once per frame instead of once per iteration.
+void mass_weights(const Rows& r, int n, float* __restrict ka, float* __restrict kb) {
+  const float* __restrict iw = r.iw;
+  for (int i = 1; i < n; ++i) {
+    const int a = (i - 1) * W, b = i * W;
+    LANES {
+      const float wsum = iw[a + l] + iw[b + l];
+      ka[b + l] = iw[a + l] / wsum;
+      kb[b + l] = iw[b + l] / wsum;
     }
   }
 }
@@ -229,7 +300,8 @@ void rest_edges_m3(const Rows& r, int n, const Substep& s, float* ex, float* ey,
 }
 
 // ...then every iteration's goals are P_{i-1} + that edge, in even/odd batches (§5).
-void local_m3(const Rows& r, int n, const float* ex, const float* ey, const float* ez, float stiffness) {
+void local_m3(const Rows& r, int n, const float* ex, const float* ey, const float* ez, const float* ka,
+              const float* kb, float stiffness) {
   alignas(64) float gx[W], gy[W], gz[W];
   for (int first : {2, 3})
     for (int i = first; i < n; i += 2) {
@@ -239,45 +311,60 @@ void local_m3(const Rows& r, int n, const float* ex, const float* ey, const floa
         gy[l] = r.py[a + l] + ey[b + l];
         gz[l] = r.pz[a + l] + ez[b + l];
       }
-      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, gx, gy, gz,
+      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, ka + b, kb + b, gx, gy, gz,
                  stiffness);
     }
 }
 
-// Method 1 (Algorithm 3): serial root to tip, the frame rebuilt after every edge.
-void local_m1(const Rows& r, int n, const float* lx, const float* ly, const float* lz, const float* rest_frames,
-              const Substep& s, float stiffness) {
+// Method 1 (Algorithm 3): serial root to tip, the frame rebuilt after every edge. Each
+// edge waits on the frame of the one before (a chain of square roots and divisions), so
+// C blocks run side by side: their chains are independent and overlap in the core.
+struct M1Block {
+  Rows r;
+  const float *lx, *ly, *lz, *rest_frames, *ka, *kb;
+};
+
+template <int C>
+void local_m1(const M1Block* blk, int n, const Substep& s, float stiffness) {
   if (n < 3) return;
-  alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[W], gy[W], gz[W];
+  alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[C][W], gy[C][W], gz[C][W];
   LANES {
     hx[l] = s.q[0];
     hy[l] = s.q[1];
     hz[l] = s.q[2];
     hw[l] = s.q[3];
   }
-  const float* rr1 = rest_frames + 4 * W;  // w, x, y, z rows of wR_1^0
-  Quat frame, next;
-  quat_mul(hx, hy, hz, hw, rr1 + W, rr1 + 2 * W, rr1 + 3 * W, rr1, frame);
+  Quat frame[C], next[C];
+  for (int j = 0; j < C; ++j) {
+    const float* rr1 = blk[j].rest_frames + 4 * W;  // w, x, y, z rows of wR_1^0
+    quat_mul(hx, hy, hz, hw, rr1 + W, rr1 + 2 * W, rr1 + 3 * W, rr1, frame[j]);
+  }
   for (int i = 2; i < n; ++i) {
     const int a = (i - 1) * W, b = i * W;
-    LANES {
-      float ox, oy, oz;
-      rotate(frame.x[l], frame.y[l], frame.z[l], frame.w[l], lx[b + l], ly[b + l], lz[b + l], ox, oy, oz);
-      gx[l] = r.px[a + l] + ox;
-      gy[l] = r.py[a + l] + oy;
-      gz[l] = r.pz[a + l] + oz;
+    for (int j = 0; j < C; ++j) {
+      const M1Block& k = blk[j];
+      const Rows& r = k.r;
+      LANES {
+        float ox, oy, oz;
+        rotate(frame[j].x[l], frame[j].y[l], frame[j].z[l], frame[j].w[l], k.lx[b + l], k.ly[b + l], k.lz[b + l], ox,
+               oy, oz);
+        gx[j][l] = r.px[a + l] + ox;
+        gy[j][l] = r.py[a + l] + oy;
+        gz[j][l] = r.pz[a + l] + oz;
+      }
+      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, k.ka + b, k.kb + b,
+                 gx[j], gy[j], gz[j], stiffness);
+      child_frame(frame[j], r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, next[j]);
     }
-    local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, gx, gy, gz,
-               stiffness);
-    child_frame(frame, r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, next);
-    frame = next;
+    for (int j = 0; j < C; ++j) frame[j] = next[j];
   }
 }
 
 // Method 2 (Algorithm 4): goals from the previous iteration's frames (copied to
 // scratch), even/odd batches, then every frame rebuilt from its parent's old frame.
 void local_m2(const Rows& r, int n, const float* lx, const float* ly, const float* lz, const float* rest_frames,
-              float* ow, float* ox, float* oy, float* oz, float* scratch, const Substep& s, float stiffness) {
+              float* ow, float* ox, float* oy, float* oz, float* scratch, const float* ka, const float* kb,
+              const Substep& s, float stiffness) {
   if (n < 3) return;
   alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[W], gy[W], gz[W];
   LANES {
@@ -299,12 +386,11 @@ void local_m2(const Rows& r, int n, const float* lx, const float* ly, const floa
   }
   const int nw = n * W;
   float *sw = scratch, *sx = scratch + nw, *sy = scratch + 2 * nw, *sz = scratch + 3 * nw;
-  for (int j = 0; j < nw; ++j) {
-    sw[j] = ow[j];
-    sx[j] = ox[j];
-    sy[j] = oy[j];
-    sz[j] = oz[j];
-  }
+  const std::size_t bytes = static_cast<std::size_t>(nw) * sizeof(float);
+  std::memcpy(sw, ow, bytes);
+  std::memcpy(sx, ox, bytes);
+  std::memcpy(sy, oy, bytes);
+  std::memcpy(sz, oz, bytes);
   for (int first : {2, 3})
     for (int i = first; i < n; i += 2) {
       const int a = (i - 1) * W, b = i * W;
@@ -315,7 +401,7 @@ void local_m2(const Rows& r, int n, const float* lx, const float* ly, const floa
         gy[l] = r.py[a + l] + ty;
         gz[l] = r.pz[a + l] + tz;
       }
-      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, gx, gy, gz,
+      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, ka + b, kb + b, gx, gy, gz,
                  stiffness);
     }
   Quat parent, out;
@@ -363,9 +449,10 @@ void edge_length(const Rows& r, int n) {
 
 // Sphere collisions (collide_spheres): up to four passes; a lane whose pass moved
 // nothing would move nothing in later passes either, so passes stop when no lane moved.
-void collide(const Rows& r, int n, const Substep& s) {
+void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < n; ++i) {
+    if (kinds[i] == kRowPinned) continue;
     const int o = i * W;
     float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
     const float* iw = r.iw + o;
@@ -378,14 +465,14 @@ void collide(const Rows& r, int n, const Substep& s) {
         LANES {
           const float dx = px[l] - cx, dy = py[l] - cy, dz = pz[l] - cz;
           const float d2 = dx * dx + (dy * dy + dz * dz);
-          inside_any |= (iw[l] != 0.0f && d2 < cr * cr) ? 1 : 0;
+          inside_any |= static_cast<int>((iw[l] != 0.0f) & (d2 < cr * cr));
         }
         if (!inside_any) continue;
         moved = 1;
         LANES {
           const float dx = px[l] - cx, dy = py[l] - cy, dz = pz[l] - cz;
           const float d2 = dx * dx + (dy * dy + dz * dz);
-          const bool inside = iw[l] != 0.0f && d2 < cr * cr;
+          const bool inside = (iw[l] != 0.0f) & (d2 < cr * cr);
           const float d = std::sqrt(d2);
           const bool centre = !(d > 0.0f);
           const float nx = centre ? 0.0f : dx / d, ny = centre ? 1.0f : dy / d, nz = centre ? 0.0f : dz / d;
@@ -399,68 +486,104 @@ void collide(const Rows& r, int n, const Substep& s) {
   }
 }
 
-void frame(const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
+// What the stages need of one block.
+struct Ctx {
+  Rows r;
+  const RowKind* kinds;
+  float* d;
+  float *scratch, *ka, *kb;
+  const float* rest_frames;
+  float* field(int k) const { return d + static_cast<std::size_t>(k) * rows; }
+  std::size_t rows;
+};
+
+void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f, float* out, float* scratch,
            std::int64_t* stage_ns) {
-  const int n = b.n;
+  const int n = blocks[0].n, method = blocks[0].method;
   const std::size_t rows = static_cast<std::size_t>(n) * W;
-  float* d = b.data;
-  auto field = [&](int k) { return d + static_cast<std::size_t>(k) * rows; };
-  const Rows r{field(PX), field(PY), field(PZ), field(QX), field(QY), field(QZ),
-               field(IW), field(RX), field(RY), field(RZ), field(RL)};
-  const float* rest_frames = b.method == 3 ? nullptr : d + static_cast<std::size_t>(field_count(b.method)) * rows;
+  Ctx c[kMaxBlocks];
+  M1Block m1[kMaxBlocks];
+  for (int j = 0; j < count; ++j) {
+    float* d = blocks[j].data;
+    auto field = [&](int k) { return d + static_cast<std::size_t>(k) * rows; };
+    float* sc = scratch + static_cast<std::size_t>(j) * scratch_floats(n);
+    c[j] = Ctx{{field(PX), field(PY), field(PZ), field(QX), field(QY), field(QZ), field(IW), field(RX), field(RY),
+                field(RZ), field(RL)},
+               blocks[j].rows,
+               d,
+               sc,
+               sc + 4 * rows,
+               sc + 5 * rows,
+               method == 3 ? nullptr : d + static_cast<std::size_t>(field_count(method)) * rows,
+               rows};
+    if (method == 1)
+      m1[j] = M1Block{c[j].r, field(LX), field(LY), field(LZ), c[j].rest_frames, c[j].ka, c[j].kb};
+  }
   const bool local_on = p.local_iterations > 0;
   const int iterations = p.local_iterations > p.length_iterations ? p.local_iterations : p.length_iterations;
   Clock clock(stage_ns);
+  if (local_on) {
+    for (int j = 0; j < count; ++j) mass_weights(c[j].r, n, c[j].ka, c[j].kb);
+    clock.lap(kLocal);
+  }
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
-    if (f.windy)
-      integrate<true>(r, n, s, f, p.keep);
-    else
-      integrate<false>(r, n, s, f, p.keep);
+    for (int j = 0; j < count; ++j) {
+      if (f.windy)
+        integrate<true>(c[j].r, c[j].kinds, n, s, f, p.keep);
+      else
+        integrate<false>(c[j].r, c[j].kinds, n, s, f, p.keep);
+    }
     clock.lap(kIntegrate);
     if (p.global_on) {
-      global_shape(r, n, s, p);
+      for (int j = 0; j < count; ++j) global_shape(c[j].r, c[j].kinds, n, s, p);
       clock.lap(kGlobal);
     }
-    if (local_on && b.method == 3) {
-      rest_edges_m3(r, n, s, scratch, scratch + rows, scratch + 2 * rows);
+    if (local_on && method == 3) {
+      for (int j = 0; j < count; ++j) rest_edges_m3(c[j].r, n, s, c[j].scratch, c[j].scratch + rows, c[j].scratch + 2 * rows);
       clock.lap(kLocal);
     }
     // Algorithm 1 lines 7-9: local shape and edge length alternate, each up to its count.
     for (int it = 0; it < iterations; ++it) {
       if (it < p.local_iterations) {
-        switch (b.method) {
-          case 1:
-            local_m1(r, n, field(LX), field(LY), field(LZ), rest_frames, s, p.local_stiffness);
-            break;
-          case 2:
-            local_m2(r, n, field(LX), field(LY), field(LZ), rest_frames, field(OW), field(OX), field(OY), field(OZ),
-                     scratch, s, p.local_stiffness);
-            break;
-          default:
-            local_m3(r, n, scratch, scratch + rows, scratch + 2 * rows, p.local_stiffness);
-            break;
+        if (method == 1) {
+          if (count == 2)
+            local_m1<2>(m1, n, s, p.local_stiffness);
+          else
+            local_m1<1>(m1, n, s, p.local_stiffness);
+        } else {
+          for (int j = 0; j < count; ++j) {
+            const Ctx& b = c[j];
+            if (method == 2)
+              local_m2(b.r, n, b.field(LX), b.field(LY), b.field(LZ), b.rest_frames, b.field(OW), b.field(OX),
+                       b.field(OY), b.field(OZ), b.scratch, b.ka, b.kb, s, p.local_stiffness);
+            else
+              local_m3(b.r, n, b.scratch, b.scratch + rows, b.scratch + 2 * rows, b.ka, b.kb, p.local_stiffness);
+          }
         }
         clock.lap(kLocal);
       }
       if (it < p.length_iterations) {
-        edge_length(r, n);
+        for (int j = 0; j < count; ++j) edge_length(c[j].r, n);
         clock.lap(kLength);
       }
     }
     if (s.sphere_count > 0) {
-      collide(r, n, s);
+      for (int j = 0; j < count; ++j) collide(c[j].r, c[j].kinds, n, s);
       clock.lap(kCollision);
     }
   }
-  for (int l = 0; l < W; ++l) {
-    if (b.out_offset[l] == kNoStrand) continue;
-    float* o = out + 4 * static_cast<std::size_t>(b.out_offset[l]);
-    for (int i = 0; i < n; ++i) {
-      o[4 * i] = r.px[i * W + l];
-      o[4 * i + 1] = r.py[i * W + l];
-      o[4 * i + 2] = r.pz[i * W + l];
-      o[4 * i + 3] = r.iw[i * W + l];
+  for (int j = 0; j < count; ++j) {
+    const Rows& r = c[j].r;
+    for (int l = 0; l < W; ++l) {
+      if (blocks[j].out_offset[l] == kNoStrand) continue;
+      float* o = out + 4 * static_cast<std::size_t>(blocks[j].out_offset[l]);
+      for (int i = 0; i < n; ++i) {
+        o[4 * i] = r.px[i * W + l];
+        o[4 * i + 1] = r.py[i * W + l];
+        o[4 * i + 2] = r.pz[i * W + l];
+        o[4 * i + 3] = r.iw[i * W + l];
+      }
     }
   }
 }

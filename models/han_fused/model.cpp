@@ -12,7 +12,7 @@ namespace hairbench::han_fused {
 namespace soa = hairbench::kernels::han_soa;
 constexpr int W = soa::kLanes;
 
-// One block in this many (and the first block of every region) times its stages.
+// One job in this many (and the first job of every region) times its stages.
 constexpr std::size_t kSampleEvery = 16;
 
 HanFusedModel::HanFusedModel(han::Method method, const ModelContext& ctx)
@@ -83,7 +83,6 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
     b.n = n;
     b.method = region_method[region];
     b.region = region;
-    b.sampled = blocks_.size() % kSampleEvery == 0 || blocks_.empty() || blocks_.back().region != region;
     std::array<std::uint32_t, W> strands{};
     for (int l = 0; l < W; ++l) {
       const bool used = i + static_cast<std::size_t>(l) < j;
@@ -97,6 +96,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
 
   data_.assign(floats, 0.0f);
+  row_kinds_.clear();
   int max_n = 0;
   any_global_ = any_local_ = any_length_ = false;
   for (std::size_t k = 0; k < blocks_.size(); ++k) {
@@ -109,6 +109,12 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
     const std::size_t rows = static_cast<std::size_t>(b.n) * W;
     float* d = data_.data() + b.offset;
     auto at = [&](int field, int i, int l) -> float& { return d[field * rows + static_cast<std::size_t>(i) * W + l]; };
+    blocks_[k].row_kinds = row_kinds_.size();
+    for (int i = 0; i < b.n; ++i) {
+      int pinned = 0;
+      for (int l = 0; l < W; ++l) pinned += rest.positions[rest.strand_begin(lanes[k][l]) + i].w() == 0.0f;
+      row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
+    }
     for (int l = 0; l < W; ++l) {
       const std::size_t v0 = rest.strand_begin(lanes[k][l]);
       for (int i = 0; i < b.n; ++i) {
@@ -144,18 +150,28 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
   pos_ = rest.positions;
 
-  // Static partition of the blocks over the threads by estimated cost (vertices times
+  // Jobs: blocks in pairs where two consecutive ones share region and vertex count.
+  jobs_.clear();
+  for (std::size_t k = 0; k < blocks_.size();) {
+    const bool pair = k + 1 < blocks_.size() && blocks_[k + 1].region == blocks_[k].region &&
+                      blocks_[k + 1].n == blocks_[k].n;
+    const bool first_of_region = jobs_.empty() || blocks_[jobs_.back().first].region != blocks_[k].region;
+    jobs_.push_back({k, pair ? 2 : 1, jobs_.size() % kSampleEvery == 0 || first_of_region});
+    k += pair ? 2 : 1;
+  }
+
+  // Static partition of the jobs over the threads by estimated cost (vertices times
   // passes over them), fixed at reset: which thread runs a block never changes a bit of
   // its result, so any thread count gives the same state.
   const int threads = ctx_.pool ? ctx_.pool->threads() : 1;
-  std::vector<double> cost(blocks_.size());
+  std::vector<double> cost(jobs_.size());
   double total = 0.0;
-  for (std::size_t k = 0; k < blocks_.size(); ++k) {
-    const BlockInfo& b = blocks_[k];
+  for (std::size_t j = 0; j < jobs_.size(); ++j) {
+    const BlockInfo& b = blocks_[jobs_[j].first];
     const soa::BlockParams& p = region_[b.region];
-    const double local_cost = b.method == 1 ? 8.0 : b.method == 2 ? 7.0 : 1.0;
-    cost[k] = b.n * (3.0 + local_cost * p.local_iterations + p.length_iterations);
-    total += cost[k];
+    const double local_cost = b.method == 1 ? 4.0 : b.method == 2 ? 4.0 : 1.0;
+    cost[j] = jobs_[j].count * b.n * (3.0 + local_cost * p.local_iterations + p.length_iterations);
+    total += cost[j];
   }
   threads_.assign(static_cast<std::size_t>(threads), ThreadState{});
   double acc = 0.0;
@@ -163,10 +179,10 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   for (int t = 0; t < threads; ++t) {
     threads_[t].first = k;
     const double end = total * (t + 1) / threads;
-    while (k < blocks_.size() && (t == threads - 1 || acc + 0.5 * cost[k] < end)) acc += cost[k++];
+    while (k < jobs_.size() && (t == threads - 1 || acc + 0.5 * cost[k] < end)) acc += cost[k++];
     threads_[t].last = k;
   }
-  scratch_stride_ = soa::scratch_floats(max_n);
+  scratch_stride_ = soa::kMaxBlocks * soa::scratch_floats(max_n);
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
   substep_.assign(static_cast<std::size_t>(substeps_), soa::Substep{});
   spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
@@ -180,17 +196,22 @@ void HanFusedModel::run_thread(int t) {
   ThreadState& ts = threads_[static_cast<std::size_t>(t)];
   float* out = pos_.data()->data();
   float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
-  for (std::size_t k = ts.first; k < ts.last; ++k) {
-    const BlockInfo& b = blocks_[k];
-    soa::BlockParams p = region_[b.region];
-    p.global_reach = p.global_reach * static_cast<float>(b.n);  // range · n, as global_shape
-    const soa::Block block{data_.data() + b.offset, b.n, b.method, b.out_offset.data()};
-    if (!b.sampled) {
-      kernel_(block, p, frame_, out, scratch, nullptr);
+  for (std::size_t j = ts.first; j < ts.last; ++j) {
+    const Job& job = jobs_[j];
+    const BlockInfo& first = blocks_[job.first];
+    soa::BlockParams p = region_[first.region];
+    p.global_reach = p.global_reach * static_cast<float>(first.n);  // range · n, as global_shape
+    soa::Block blocks[soa::kMaxBlocks];
+    for (int i = 0; i < job.count; ++i) {
+      const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
+      blocks[i] = {data_.data() + b.offset, b.n, b.method, b.out_offset.data(), row_kinds_.data() + b.row_kinds};
+    }
+    if (!job.sampled) {
+      kernel_(blocks, job.count, p, frame_, out, scratch, nullptr);
       continue;
     }
     const auto start = std::chrono::steady_clock::now();
-    kernel_(block, p, frame_, out, scratch, ts.stage_ns.data());
+    kernel_(blocks, job.count, p, frame_, out, scratch, ts.stage_ns.data());
     ts.sampled_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start)
                          .count();
   }

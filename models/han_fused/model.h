@@ -43,15 +43,21 @@ class HanFusedModel final : public HairModel {
  private:
   struct BlockInfo {
     std::size_t offset;  // into data_
+    std::size_t row_kinds;  // into row_kinds_
     int n, method;
     std::uint16_t region;
-    bool sampled;  // times its stages (see step())
     std::array<std::uint32_t, kernels::han_soa::kLanes> out_offset;
+  };
+  // One kernel call: up to kMaxBlocks consecutive blocks of one region and vertex count.
+  struct Job {
+    std::size_t first;
+    int count;
+    bool sampled;  // times its stages (see step())
   };
   struct alignas(64) ThreadState {
     std::array<std::int64_t, kernels::han_soa::kStageCount> stage_ns{};
     std::int64_t sampled_ns = 0;
-    std::size_t first = 0, last = 0;  // blocks [first, last)
+    std::size_t first = 0, last = 0;  // jobs [first, last)
   };
   void run_thread(int t);
 
@@ -59,11 +65,13 @@ class HanFusedModel final : public HairModel {
   ModelContext ctx_;
   kernels::han_soa::FrameFn kernel_ = nullptr;
   std::vector<BlockInfo> blocks_;
+  std::vector<Job> jobs_;
   std::vector<kernels::han_soa::BlockParams> region_;
   FloatBuffer data_;
   FloatBuffer scratch_;  // per thread, scratch_stride_ floats each
   std::size_t scratch_stride_ = 0;
   std::vector<ThreadState> threads_;
+  std::vector<kernels::han_soa::RowKind> row_kinds_;
   std::vector<Vec4f> pos_;
   int substeps_ = 1;
   bool any_global_ = false, any_local_ = false, any_length_ = false;
