@@ -83,7 +83,7 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
     const float n2 = (0.0f * 0.0f + vy * vy) + (vz * vz + w * w);
     const float s = std::sqrt(n2);
     const bool flip = w < 1e-6f;
-    r.x[l] = flip ? 0.0f : 0.0f / s;
+    r.x[l] = 0.0f;  // 0 / s with s >= 1e-6: +0 either way
     r.y[l] = flip ? 0.0f : -vz / s;
     r.z[l] = flip ? 1.0f : vy / s;
     r.w[l] = flip ? 0.0f : w / s;
