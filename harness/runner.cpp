@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/follow_adapter.h"
+#include "harness/roofline.h"
 #include "reports/metrics.h"
 #include "scenarios/phases.h"
 
@@ -235,6 +236,10 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     const Backend backend = lane.model->backend();
     r.backend = backend.name;
     r.device = backend.device;
+    if (backend.name == "cpu") {
+      r.state_bytes = lane.model->state_bytes();
+      r.stream_ms = stream_seconds(r.state_bytes, pool) * 1e3;
+    }
     r.strands = sc.groom.strand_count();
     r.vertices = sc.groom.vertex_count();
     r.dt = sc.dt;

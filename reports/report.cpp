@@ -143,6 +143,10 @@ nlohmann::json run_json(const RunRecord& r) {
       {"stage_skipped_steps", r.stage_skipped_steps},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
 
+  if (r.stream_ms > 0.0) {
+    timing["state_bytes"] = r.state_bytes;
+    timing["roofline_ratio"] = num(med / r.stream_ms);
+  }
   if (!r.gpu_ms.empty())
     timing["gpu_ms"] = {{"mean", num(finite_mean(r.gpu_ms))},
                         {"median", num(median(r.gpu_ms))},

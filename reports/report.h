@@ -47,6 +47,10 @@ struct RunRecord {
   // Steps in which a stage was not needed and not run (issue 8); absent when never.
   std::map<std::string, std::size_t> stage_skipped_steps;
   std::uint64_t state_hash = 0;
+  // The model's state_bytes() and the time to stream them once on the run's threads
+  // (harness/roofline.h), CPU models only: timing.roofline_ratio (issue 10).
+  std::size_t state_bytes = 0;
+  double stream_ms = 0.0;
 
   // Parameters given to the reference on top of the scenario's (--reference converged);
   // empty when the reference runs at the scenario's parameters.

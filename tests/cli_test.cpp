@@ -109,6 +109,10 @@ TEST(Cli, CompareWritesTheReportContract) {
     for (const char* s : {"integrate", "global_shape", "local_shape", "length", "collision"})
       EXPECT_TRUE(run["timing"]["stage_ms"].contains(s)) << s;
     EXPECT_EQ(run["metrics"]["state_hash"].get<std::string>().size(), 16u);
+    // Issue 10: the state a step touches holds at least the positions (float4) and the
+    // previous positions (xyz); the ratio to its streaming time is reported.
+    EXPECT_GE(run["timing"]["state_bytes"].get<double>(), 28.0 * run["groom"]["vertices"].get<double>());
+    EXPECT_GT(run["timing"]["roofline_ratio"].get<double>(), 0.0);
   }
   EXPECT_EQ(j["runs"][1]["params"]["local_iterations"], 7);
   EXPECT_NE(j["runs"][0]["params"]["local_iterations"], 7);  // han_m1 keeps its own value

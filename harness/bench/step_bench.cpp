@@ -23,6 +23,7 @@
 // threads, in GB/s; BM_roofline_fma runs independent fused multiply-add chains on all
 // threads at the widest vector width the CPU has, in GFLOP/s.
 #include "core/parallel.h"
+#include "harness/roofline.h"
 #include "harness/runner.h"
 #include "reports/metrics.h"
 #include "scenarios/scenario.h"
@@ -66,30 +67,6 @@ Scenario thinned(const Scenario& sc, std::size_t keep_every) {
   }
   out.groom = std::move(thin);
   return out;
-}
-
-// Seconds to stream `bytes` once (every float read, scaled and written back) with all
-// threads of `pool`, the best of a few passes after a warm-up; cached per size and
-// thread count.
-double stream_seconds(std::size_t bytes, ThreadPool& pool) {
-  static std::map<std::pair<std::size_t, int>, double> cache;
-  const auto key = std::make_pair(bytes, pool.threads());
-  if (const auto it = cache.find(key); it != cache.end()) return it->second;
-  std::vector<float> buf(std::max<std::size_t>(bytes / sizeof(float), 1), 1.0f);
-  float* p = buf.data();
-  const std::size_t n = buf.size();
-  double best = 1e30;
-  for (int pass = 0; pass < 12; ++pass) {
-    const auto start = std::chrono::steady_clock::now();
-    pool.parallel_for(n, [p](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) p[i] = p[i] * 0.999f + 0.001f;
-    });
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (pass >= 2) best = std::min(best, s);
-  }
-  benchmark::DoNotOptimize(buf.data());
-  cache[key] = best;
-  return best;
 }
 
 void bm_step(benchmark::State& state, const ModelInfo* info, const Scenario* sc, int threads) {
