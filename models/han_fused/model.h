@@ -60,6 +60,7 @@ class HanFusedModel final : public HairModel {
     std::size_t first = 0, last = 0;  // jobs [first, last)
   };
   void run_thread(int t);
+  void prefetch(const Job& job) const;
 
   han::Method method_;
   ModelContext ctx_;
