@@ -31,7 +31,7 @@ constexpr const char* kUsage = R"(usage:
   hairbench list models|scenarios|devices
   hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL|converged]
                     [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR] [--no-charts]
-                    [--device NAME|INDEX]
+                    [--device NAME|INDEX] [--no-skip]
   hairbench sweep --scenario NAME|PATH [--scenario ...] --knob NAME=V1,V2,... [--models REGEX]
                   [--reference MODEL|converged] [--frames N] [--threads N] [--set MODEL.NAME=VALUE]...
                   [--out DIR] [--no-charts]
@@ -48,6 +48,8 @@ report whose runs carry the value as "knob" (default DIR: reports/out/sweep).
                      converged: han_m1 with 32 local and length iterations and 4 substeps
   --set M.NAME=V     parameter override; M may be * for every model that has NAME
   --no-charts        write the report only
+  --no-skip          run every stage even where the scene makes it inert (no colliders,
+                     no wind, zero stiffness) and never let strands sleep
   --device D         Vulkan device of the *_vk models, by index or name (see list
                      devices; default: the first discrete GPU, else any device)
 stress escalates one axis at a time (time step, head angular velocity and acceleration,
@@ -161,6 +163,7 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
       a.run.overrides.push_back(o);
     } else if (flag == "--out") a.out = value();
     else if (flag == "--no-charts") a.charts = false;
+    else if (flag == "--no-skip") a.run.skip_inert = false;
     else if (sweep && flag == "--knob") {
       if (a.knob) throw InputError("arguments", flag, "give one --knob per sweep");
       a.knob = parse_knob(value());
