@@ -78,7 +78,22 @@ struct ModelContext {
   ModelContext(ThreadPool* p = nullptr, std::string d = {}) : pool(p), device(std::move(d)) {}
   ThreadPool* pool = nullptr;
   std::string device;  // GPU models: --device NAME|INDEX, empty for the default device
+  // false runs every stage and term even where it is inert (no colliders, zero wind,
+  // zero stiffness) and never lets a strand sleep: the reference that shows skipping
+  // does not change the physics (issue 8), and the "off" side of the skip benchmarks.
+  bool skip_inert = true;
 };
+
+// Which per-frame stages and terms a step needs (issue 8), decided once per step from
+// its input rather than by multiplying by zero inside the kernels: no colliders -> no
+// collision pass; zero wind -> no wind term.
+struct FramePlan {
+  bool collision = true;
+  bool wind = true;
+};
+inline FramePlan plan_frame(const FrameInput& in, const ModelContext& ctx) {
+  return {!ctx.skip_inert || !in.colliders.empty(), !ctx.skip_inert || in.wind.active()};
+}
 
 // Where a model runs, for the report (run "backend" and "device").
 struct Backend {

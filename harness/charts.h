@@ -5,18 +5,21 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 namespace hairbench {
 
 // The interpreter: $HAIRBENCH_PYTHON when set, else the one found at configure time
 // ("" when none was found).
 std::string chart_python();
-// The chart script (reports/charts.py in the source tree).
-std::string chart_script();
+// A chart script in reports/ of the source tree: charts.py draws compare and sweep
+// reports, stress_chart.py the stress heatmap.
+std::string chart_script(std::string_view name = "charts.py");
 
-// Draws the charts next to `report`. Returns 0 when drawn or when they cannot be drawn
-// here (no interpreter, or it cannot import matplotlib: a one-line note on stderr says
-// what to install and the command to run later); 1 when the script failed.
-int draw_charts(const std::filesystem::path& report);
+// Draws the charts of `report` next to it with script `name`. Returns 0 when drawn or
+// when they cannot be drawn here (no interpreter, or it cannot import matplotlib: a
+// one-line note on stderr says what to install and the command to run later); 1 when
+// the script failed.
+int draw_charts(const std::filesystem::path& report, std::string_view name = "charts.py");
 
 }  // namespace hairbench

@@ -31,12 +31,12 @@ constexpr const char* kUsage = R"(usage:
   hairbench list models|scenarios|devices
   hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL|converged]
                     [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR] [--no-charts]
-                    [--device NAME|INDEX]
+                    [--device NAME|INDEX] [--no-skip]
   hairbench sweep --scenario NAME|PATH [--scenario ...] --knob NAME=V1,V2,... [--models REGEX]
                   [--reference MODEL|converged] [--frames N] [--threads N] [--set MODEL.NAME=VALUE]...
                   [--out DIR] [--no-charts]
   hairbench stress [--models REGEX] [--base SCENARIO] [--axes REGEX] [--keep-every N]
-                   [--quick] [--threads N] [--out DIR]
+                   [--quick] [--threads N] [--out DIR] [--no-charts]
 
 compare runs every selected model in lockstep on each scenario (default: every built-in
 scenario) and writes DIR/report.json (default DIR: reports/out/latest), then its charts,
@@ -48,13 +48,16 @@ report whose runs carry the value as "knob" (default DIR: reports/out/sweep).
                      converged: han_m1 with 32 local and length iterations and 4 substeps
   --set M.NAME=V     parameter override; M may be * for every model that has NAME
   --no-charts        write the report only
+  --no-skip          run every stage even where the scene makes it inert (no colliders,
+                     no wind, zero stiffness) and never let strands sleep
   --device D         Vulkan device of the *_vk models, by index or name (see list
                      devices; default: the first discrete GPU, else any device)
 stress escalates one axis at a time (time step, head angular velocity and acceleration,
 teleports, strand vertices and length, every stiffness, iteration count and damping)
 from the stable base scenario (default shake, every 10th strand) until each model fails,
-runs degenerate grooms, prints the table and writes DIR/stress.json (default DIR:
-reports/out/stress). --quick tries every other value of each axis.
+runs degenerate grooms, prints the table, writes DIR/stress.json (default DIR:
+reports/out/stress) and draws its heatmap DIR/stress_heatmap.png. --quick tries every other value
+of each axis.
 exit codes: 0 done (unstable models are results, not errors), 1 internal error or chart
 script failure, 2 bad arguments or files)";
 
@@ -161,6 +164,7 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
       a.run.overrides.push_back(o);
     } else if (flag == "--out") a.out = value();
     else if (flag == "--no-charts") a.charts = false;
+    else if (flag == "--no-skip") a.run.skip_inert = false;
     else if (sweep && flag == "--knob") {
       if (a.knob) throw InputError("arguments", flag, "give one --knob per sweep");
       a.knob = parse_knob(value());
@@ -322,6 +326,7 @@ int cmd_stress(const std::vector<std::string>& args) {
   StressOptions opt;
   std::string models = ".*", out = "reports/out/stress";
   int threads = 0;
+  bool no_charts = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& flag = args[i];
     auto value = [&]() -> const std::string& {
@@ -335,6 +340,7 @@ int cmd_stress(const std::vector<std::string>& args) {
     else if (flag == "--quick") opt.value_stride = 2;
     else if (flag == "--threads") threads = parse_int(flag, value(), 1, 1024);
     else if (flag == "--out") out = value();
+    else if (flag == "--no-charts") no_charts = true;
     else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
   }
   // The CPU models: the GPU variants run the same algorithms (issue 7's agreement
@@ -364,7 +370,7 @@ int cmd_stress(const std::vector<std::string>& args) {
   const std::filesystem::path file = std::filesystem::path(out) / "stress.json";
   write_json(file, report);
   std::printf("wrote %s\n", file.string().c_str());
-  return 0;
+  return no_charts ? 0 : draw_charts(file, "stress_chart.py");
 }
 
 int cmd_list(const std::vector<std::string>& args) {

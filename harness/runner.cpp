@@ -185,8 +185,10 @@ double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> 
 }  // namespace
 
 std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
-                                      ThreadPool& pool, const std::string& device) {
-  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool, device});
+                                      ThreadPool& pool, const std::string& device, bool skip_inert) {
+  ModelContext ctx{&pool, device};
+  ctx.skip_inert = skip_inert;
+  std::unique_ptr<HairModel> m = info.make(ctx);
   // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
   if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow);
   m->reset(sc.groom, params);
@@ -229,7 +231,7 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
   // of its model when that run's parameters are the same.
   std::vector<Lane> lanes;
   auto add_lane = [&](const ModelInfo* info, const ParamSet& params, bool reported) {
-    Lane lane{info, make_model(*info, sc, params, pool, opt.device), {}, reported, true, {}, {}};
+    Lane lane{info, make_model(*info, sc, params, pool, opt.device, opt.skip_inert), {}, reported, true, {}, {}};
     RunRecord& r = lane.record;
     r.scenario = sc.name;
     r.model = std::string(info->name);

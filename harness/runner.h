@@ -56,12 +56,16 @@ struct RunOptions {
   // Stress runs (issue 8): a model whose mechanical energy keeps growing while the head
   // is still and no wind blows also fails (metrics::EnergyGrowthCheck).
   bool energy_check = false;
+  // false (--no-skip): models run every stage even where it is inert and no strand
+  // sleeps (ModelContext::skip_inert), to show what skipping saves and that it changes
+  // nothing else.
+  bool skip_inert = true;
 };
 
 // A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides
 // when the scenario asks for it, and reset to the groom with `params`.
 std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
-                                      ThreadPool& pool, const std::string& device = "");
+                                      ThreadPool& pool, const std::string& device = "", bool skip_inert = true);
 // The input of frame f: the head script evaluated at both ends of the step.
 FrameInput frame_input(const Scenario& sc, int f);
 

@@ -17,8 +17,10 @@ try:
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
 except ImportError:
-    sys.exit(f"stress_chart.py: matplotlib is missing for {sys.executable}: "
-             "install python3-matplotlib and run with /usr/bin/python3")
+    # Exit code 3 tells hairbench (harness/charts.cpp) to print how to draw it later.
+    print(f"stress_chart.py: matplotlib is missing for {sys.executable}: "
+          "install python3-matplotlib and run with /usr/bin/python3", file=sys.stderr)
+    sys.exit(3)
 
 
 def fmt(v):

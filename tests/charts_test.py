@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Chart-script test: runs reports/charts.py on the golden reports in tests/data/reports
+"""Chart-script test: runs reports/charts.py (and stress_chart.py) on the golden reports in tests/data/reports
 and checks that every promised file exists and is non-empty, and that each chart drew
 the series the report implies (counted from the report itself, not from the manifest).
 
@@ -100,6 +100,19 @@ def check_report(charts_py, golden, tmp):
     return rep, m
 
 
+def check_stress(stress_py, golden, tmp):
+    """The `hairbench stress` heatmap: PNG and SVG written next to the report."""
+    report = os.path.join(tmp, "stress.json")
+    shutil.copy(golden, report)
+    r = subprocess.run([sys.executable, stress_py, report], capture_output=True, text=True)
+    check(r.returncode == 0, f"stress_chart.py exit {r.returncode}: {r.stderr}")
+    for ext in ("png", "svg"):
+        f = os.path.join(tmp, f"stress_heatmap.{ext}")
+        check(os.path.isfile(f) and os.path.getsize(f) > 0, f"missing or empty: {f}")
+    with open(os.path.join(tmp, "stress_heatmap.png"), "rb") as f:
+        check(f.read(8) == b"\x89PNG\r\n\x1a\n", "stress_heatmap.png is a PNG")
+
+
 def main():
     charts_py, data = sys.argv[1], sys.argv[2]
     with tempfile.TemporaryDirectory() as tmp:
@@ -114,6 +127,8 @@ def main():
             f.write('{"schema": "something-else", "runs": []}')
         r = subprocess.run([sys.executable, charts_py, bad], capture_output=True, text=True)
         check(r.returncode == 2 and r.stderr.count("\n") == 1 and "schema" in r.stderr, f"bad report: {r.stderr}")
+        check_stress(os.path.join(os.path.dirname(charts_py), "stress_chart.py"),
+                     os.path.join(data, "stress_small.json"), tmp)
     for f in failures:
         print("FAILED:", f)
     print(f"{'FAIL' if failures else 'ok'}: charts_test")

@@ -20,15 +20,14 @@ void follow_head(std::span<Vec4f> pos, std::span<Vec4f> prev, std::span<const Ve
 }
 
 void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& gravity,
-                      const Wind& wind, float damping, float dt) {
+                      const Wind& wind, bool wind_term, float damping, float dt) {
   const float keep = 1.0f - damping;
   const float dt2 = dt * dt;
   const Vec3f wind_acc = wind.acceleration();
-  const bool windy = wind.active();
   for (std::size_t i = 1; i < pos.size(); ++i) {
     if (pos[i].w() == 0.0f) continue;
     Vec3f acc = gravity;
-    if (windy) {
+    if (wind_term) {
       const Vec3f edge = xyz(pos[i]) - xyz(pos[i - 1]);
       const float len2 = edge.squaredNorm();
       const Vec3f t = len2 > 0.0f ? Vec3f(edge / std::sqrt(len2)) : Vec3f::Zero();

@@ -16,9 +16,10 @@ void follow_head(std::span<Vec4f> pos, std::span<Vec4f> prev, std::span<const Ve
 // Verlet integration with damping (Halén & Wester Eq. 4.1, Han & Harada §3.2):
 //   p' = p + (1 - damping)(p - p_prev) + a dt²   for vertices with w != 0,
 // a = gravity + the part of the wind acceleration normal to the vertex's edge (a thin
-// cylinder only catches the wind that meets it face-on).
+// cylinder only catches the wind that meets it face-on). The wind term is computed only
+// when `wind_term` is set: the caller decides once per step whether there is wind.
 void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& gravity,
-                      const Wind& wind, float damping, float dt);
+                      const Wind& wind, bool wind_term, float damping, float dt);
 
 // Global shape constraint (Han & Harada Eq. 2): P_i += S_G (T_H · P_i^0 - P_i) for the
 // free vertices with i < range · n; with `ramp`, S_G falls linearly to 0 at that point

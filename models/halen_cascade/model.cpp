@@ -18,6 +18,7 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   for (std::size_t r = 0; r < rest.region_names.size(); ++r)
     region_.push_back({static_cast<float>(params.get("damping", r)), params.get_int("length_iterations", r)});
   substeps_ = params.get_int("substeps");
+  sleep_.reset(rest.strand_count());
 
   const std::size_t nv = rest.vertex_count();
   std::vector<float> arc(nv);
@@ -68,23 +69,37 @@ std::span<T> CascadeModel::strand(std::vector<T>& v, std::size_t s) {
   return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));
 }
 
+// Visits every awake strand; a sleeping strand is not touched (issue 8).
 template <class F>
 void CascadeModel::for_each_strand(F&& f) {
   ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) f(s, region_[rest_.strand_region[s]]);
+    for (std::size_t s = begin; s < end; ++s)
+      if (!sleep_.asleep(s)) f(s, region_[rest_.strand_region[s]]);
   });
 }
 
 void CascadeModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    // Every strand sleeps: not even the per-strand checks run (issue 8).
+    for (std::string_view stage : {"references", "integrate", "length", "collision"}) times.skip(stage);
+    return;
+  }
   for (int i = 1; i <= substeps_; ++i) {
     const float s = static_cast<float>(i) / static_cast<float>(substeps_);
     substep(interpolate_head(in.head_prev, in.head, s), in, dt, times);
+  }
+  if (calm) {
+    StageTimer t(times, "sleep");
+    for_each_strand([&](std::size_t s, const RegionSettings&) { sleep_.observe(s, strand(pos_, s), strand(prev_, s), dt); });
+    sleep_.end_observe();
   }
 }
 
 // §4.3's four steps: tangent spaces, reference nodes, simulation, correction.
 void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
+  const FramePlan plan = plan_frame(in, ctx_);
   const k::Mat3f head_rotation = head.linear();
   {
     StageTimer t(times, "references");
@@ -100,7 +115,7 @@ void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt,
     StageTimer t(times, "integrate");
     for_each_strand([&](std::size_t s, const RegionSettings& r) {
       const std::size_t n = rest_.strand_size(s);
-      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, r.damping, dt);
+      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, plan.wind, r.damping, dt);
       k::add_spring_acceleration(strand(pos_, s), strand(prev_, s), strand(up_ref_, s), strand(k_up_, s), 1.0f, dt);
       if (n > 2)
         k::add_spring_acceleration(strand(pos_, s).first(n - 2), strand(prev_, s).first(n - 2),
@@ -113,7 +128,9 @@ void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt,
       for (int it = 0; it < r.length_iterations; ++it) k::edge_length(strand(pos_, s), strand(rest_length_, s));
     });
   }
-  {
+  if (!plan.collision) {
+    times.skip("collision");
+  } else {
     StageTimer t(times, "collision");
     spheres_.clear();
     for (const Sphere& c : in.colliders) {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/sleep.h"
 #include "kernels/cpu/halen_kernels.h"
 
 #include <memory>
@@ -43,6 +44,7 @@ class CascadeModel final : public HairModel {
   std::vector<Vec3f> up_ref_, down_ref_;            // ... in world space, this substep
   std::vector<RegionSettings> region_;
   int substeps_ = 1;
+  StrandSleep sleep_;
   std::vector<Vec4f> pos_, prev_;
   std::vector<Vec4f> spheres_;
 };

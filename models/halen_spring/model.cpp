@@ -20,6 +20,7 @@ void SpringModel::reset(const Groom& rest, const ParamSet& params) {
     region_.push_back({static_cast<float>(params.get("damping", r)), static_cast<float>(params.get("tilt_min", r)),
                        params.get_int("length_iterations", r)});
   substeps_ = params.get_int("substeps");
+  sleep_.reset(rest.strand_count());
 
   std::vector<float> arc(rest.vertex_count());
   k_.resize(rest.vertex_count());
@@ -49,22 +50,36 @@ std::span<T> SpringModel::strand(std::vector<T>& v, std::size_t s) {
   return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));
 }
 
+// Visits every awake strand; a sleeping strand is not touched (issue 8).
 template <class F>
 void SpringModel::for_each_strand(F&& f) {
   ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) f(s, region_[rest_.strand_region[s]]);
+    for (std::size_t s = begin; s < end; ++s)
+      if (!sleep_.asleep(s)) f(s, region_[rest_.strand_region[s]]);
   });
 }
 
 void SpringModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    // Every strand sleeps: not even the per-strand checks run (issue 8).
+    for (std::string_view stage : {"references", "integrate", "length", "collision"}) times.skip(stage);
+    return;
+  }
   for (int i = 1; i <= substeps_; ++i) {
     const float s = static_cast<float>(i) / static_cast<float>(substeps_);
     substep(interpolate_head(in.head_prev, in.head, s), in, dt, times);
   }
+  if (calm) {
+    StageTimer t(times, "sleep");
+    for_each_strand([&](std::size_t s, const RegionSettings&) { sleep_.observe(s, strand(pos_, s), strand(prev_, s), dt); });
+    sleep_.end_observe();
+  }
 }
 
 void SpringModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
+  const FramePlan plan = plan_frame(in, ctx_);
   // §4.4: "z is the up vector, z_h the up vector of the head" — up is against gravity.
   const Vec3f up = in.gravity.squaredNorm() > 0.0f ? Vec3f(-in.gravity.normalized()) : Vec3f::UnitY();
   const Vec3f head_up = head.linear() * up;
@@ -79,7 +94,7 @@ void SpringModel::substep(const Affine3f& head, const FrameInput& in, float dt, 
     for_each_strand([&](std::size_t s, const RegionSettings& r) {
       const auto rest = std::span<const Vec4f>(rest_.positions).subspan(rest_.strand_begin(s), rest_.strand_size(s));
       k::follow_head(strand(pos_, s), strand(prev_, s), rest, head);
-      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, r.damping, dt);
+      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, plan.wind, r.damping, dt);
       k::add_spring_acceleration(strand(pos_, s), strand(prev_, s), strand(ref_, s), strand(k_, s),
                                  k::tilt_factor(up, head_up, r.tilt_min), dt);
     });
@@ -90,7 +105,9 @@ void SpringModel::substep(const Affine3f& head, const FrameInput& in, float dt, 
       for (int it = 0; it < r.length_iterations; ++it) k::edge_length(strand(pos_, s), strand(rest_length_, s));
     });
   }
-  {
+  if (!plan.collision) {
+    times.skip("collision");
+  } else {
     StageTimer t(times, "collision");
     spheres_.clear();
     for (const Sphere& c : in.colliders) {

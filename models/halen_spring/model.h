@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/sleep.h"
 
 #include <memory>
 #include <vector>
@@ -39,6 +40,7 @@ class SpringModel final : public HairModel {
   std::vector<Vec3f> ref_;          // ... in world space, this substep
   std::vector<RegionSettings> region_;
   int substeps_ = 1;
+  StrandSleep sleep_;
   std::vector<Vec4f> pos_, prev_;
   std::vector<Vec4f> spheres_;
 };

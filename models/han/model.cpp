@@ -28,6 +28,7 @@ void HanModel::reset(const Groom& rest, const ParamSet& params) {
 
   region_.clear();
   max_iterations_ = 0;
+  any_global_pass_ = any_local_pass_ = false;
   for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
     RegionSettings rs{};
     rs.damping = static_cast<float>(params.get("damping", r));
@@ -37,33 +38,56 @@ void HanModel::reset(const Groom& rest, const ParamSet& params) {
     rs.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
     rs.local_iterations = params.get_int("local_iterations", r);
     rs.length_iterations = params.get_int("length_iterations", r);
+    const int method = params.get_int("method", r);
+    rs.method = method == 0 ? method_ : static_cast<Method>(method);
+    // Issue 8: a pass whose stiffness or reach is 0 changes nothing, so it is not run.
+    rs.global_pass = !ctx_.skip_inert || (rs.global_stiffness != 0.0f && rs.global_range != 0.0f);
+    rs.local_pass = rs.local_iterations > 0 && (!ctx_.skip_inert || rs.local_stiffness != 0.0f);
+    any_global_pass_ = any_global_pass_ || rs.global_pass;
+    any_local_pass_ = any_local_pass_ || rs.local_pass;
     max_iterations_ = std::max({max_iterations_, rs.local_iterations, rs.length_iterations});
     region_.push_back(rs);
   }
   substeps_ = params.get_int("substeps");
+  sleep_.reset(rest.strand_count());
 }
 
 std::span<Vec4f> HanModel::strand(std::vector<Vec4f>& v, std::size_t s) {
   return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));
 }
 
+// Visits every awake strand; a sleeping strand is not touched by any stage.
 template <class F>
 void HanModel::for_each_strand(F&& f) {
   ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) f(s, region_[rest_.strand_region[s]]);
+    for (std::size_t s = begin; s < end; ++s)
+      if (!sleep_.asleep(s)) f(s, region_[rest_.strand_region[s]]);
   });
 }
 
 void HanModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    // Every strand sleeps: not even the per-strand checks run (issue 8).
+    for (std::string_view stage : {"integrate", "global_shape", "local_shape", "length", "collision"}) times.skip(stage);
+    return;
+  }
+  const FramePlan plan = plan_frame(in, ctx_);
   for (int k = 1; k <= substeps_; ++k) {
     const float s = static_cast<float>(k) / static_cast<float>(substeps_);
-    substep(interpolate_head(in.head_prev, in.head, s), in, dt, times);
+    substep(interpolate_head(in.head_prev, in.head, s), in, plan, dt, times);
+  }
+  if (calm) {
+    StageTimer t(times, "sleep");
+    for_each_strand([&](std::size_t s, const RegionSettings&) { sleep_.observe(s, strand(pos_, s), strand(prev_, s), dt); });
+    sleep_.end_observe();
   }
 }
 
 // One pass of Algorithm 1.
-void HanModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
+void HanModel::substep(const Affine3f& head, const FrameInput& in, const FramePlan& plan, float dt,
+                       StageTimes& times) {
   const Quatf head_rotation(head.rotation());
   {
     StageTimer t(times, "integrate");
@@ -71,12 +95,15 @@ void HanModel::substep(const Affine3f& head, const FrameInput& in, float dt, Sta
       k::follow_head(strand(pos_, s), strand(prev_, s),
                      std::span<const Vec4f>(rest_.positions).subspan(rest_.strand_begin(s), rest_.strand_size(s)),
                      head);
-      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, r.damping, dt);
+      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, plan.wind, r.damping, dt);
     });
   }
-  {
+  if (!any_global_pass_) {
+    times.skip("global_shape");
+  } else {
     StageTimer t(times, "global_shape");
     for_each_strand([&](std::size_t s, const RegionSettings& r) {
+      if (!r.global_pass) return;
       const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
       k::global_shape(strand(pos_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n), head,
                       r.global_stiffness, r.global_range, r.global_ramp);
@@ -85,14 +112,16 @@ void HanModel::substep(const Affine3f& head, const FrameInput& in, float dt, Sta
   // Algorithm 1 lines 7-9: local shape and edge length constraints alternate; each
   // region stops after its own iteration counts.
   for (int it = 0; it < max_iterations_; ++it) {
-    {
+    if (!any_local_pass_) {
+      times.skip("local_shape");
+    } else {
       StageTimer t(times, "local_shape");
       for_each_strand([&](std::size_t s, const RegionSettings& r) {
-        if (it >= r.local_iterations) return;
+        if (!r.local_pass || it >= r.local_iterations) return;
         const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
         const auto rest_rot = std::span<const Quatf>(rest_rotation_).subspan(b, n);
         const auto rest_loc = std::span<const Vec3f>(rest_local_).subspan(b, n);
-        switch (method_) {
+        switch (r.method) {
           case Method::Serial:
             k::local_shape_m1(strand(pos_, s), rest_rot, rest_loc, head_rotation, r.local_stiffness);
             break;
@@ -117,7 +146,9 @@ void HanModel::substep(const Affine3f& head, const FrameInput& in, float dt, Sta
       });
     }
   }
-  {
+  if (!plan.collision) {
+    times.skip("collision");
+  } else {
     StageTimer t(times, "collision");
     spheres_.clear();
     for (const Sphere& c : in.colliders) {

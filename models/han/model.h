@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/sleep.h"
 
 #include <memory>
 #include <vector>
@@ -29,8 +30,11 @@ class HanModel final : public HairModel {
     float damping, global_stiffness, global_range, local_stiffness;
     int local_iterations, length_iterations;
     bool global_ramp;
+    Method method;      // this region's local shape method (§6: LOD by region)
+    bool global_pass;   // false when S_G or the range is 0 and inert stages are skipped
+    bool local_pass;    // false when S_L is 0 or there are no local iterations
   };
-  void substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times);
+  void substep(const Affine3f& head, const FrameInput& in, const FramePlan& plan, float dt, StageTimes& times);
   template <class F>
   void for_each_strand(F&& f);
   std::span<Vec4f> strand(std::vector<Vec4f>& v, std::size_t s);
@@ -44,6 +48,8 @@ class HanModel final : public HairModel {
   std::vector<RegionSettings> region_;
   int substeps_ = 1;
   int max_iterations_ = 0;
+  bool any_global_pass_ = false, any_local_pass_ = false;
+  StrandSleep sleep_;
 
   std::vector<Vec4f> pos_, prev_;
   std::vector<Quatf> rotation_, scratch_;  // method 2's persistent frames and their copy

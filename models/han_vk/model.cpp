@@ -78,6 +78,14 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   std::vector<L::HanRegion> regions;
   max_iterations_ = 0;
   for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
+    // The method is a specialization constant of the one pipeline, so every region
+    // runs the model's own method; a region asking for another is refused, not ignored.
+    const int method = params.get_int("method", r);
+    if (method != 0 && method != static_cast<int>(method_))
+      throw InputError("regions." + rest.region_names[r], "method",
+                       std::to_string(method) + " differs from this model's method " +
+                           std::to_string(static_cast<int>(method_)) +
+                           "; per-region methods run on the CPU models only");
     L::HanRegion g{};
     g.damping = static_cast<float>(params.get("damping", r));
     g.global_stiffness = static_cast<float>(params.get("global_stiffness", r));

@@ -214,6 +214,10 @@ void PlanteWispModel::detect_self_interactions() {
 // (3) velocities then their modifications, (4) positions then their modifications;
 // skeleton before envelope, root to tip (inside the kernels).
 void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
+  // Issue 8: without colliders there is no body pass at all, and the report says so;
+  // --no-skip runs the pass over no spheres.
+  const bool body_pass = !in.colliders.empty() || !ctx_.skip_inert;
+  if (!body_pass) times.skip("body_collision");
   const int steps = std::max(1, static_cast<int>(std::ceil(in.dt * integration_hz_ - 1e-9)));
   const float h = static_cast<float>(in.dt / steps);
   const double t0 = in.t - in.dt;
@@ -245,7 +249,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     }
     // Bodies: sliding contact for the masses the last body detection found near them,
     // on the steps that detect (the position reaction follows the position update).
-    const bool body_due = collision_hz_ > 0.0 && !in.colliders.empty() && (crosses(collision_hz_, i) || i == steps);
+    const bool body_due = collision_hz_ > 0.0 && body_pass && (crosses(collision_hz_, i) || i == steps);
     if (body_due) {
       StageTimer t(times, "body_collision");
       spheres_.clear();
