@@ -31,19 +31,19 @@ Scenario paper_model1(std::size_t keep_every) {
 }
 
 std::unique_ptr<HairModel> make(const std::string& name, const Scenario& sc, const std::vector<ParamOverride>& ov,
-                                ThreadPool& pool) {
+                                ThreadPool& pool, bool skip_inert = true) {
   const ModelInfo* info = find_model(name);
   if (!info) throw std::runtime_error("no model " + name);
-  return make_model(*info, sc, resolve_params(*info, sc, ov), pool);
+  return make_model(*info, sc, resolve_params(*info, sc, ov), pool, "", skip_inert);
 }
 
 // Steps two models in lockstep; the first frame whose positions differ in any bit, or
 // -1. `max_diff` gets the largest coordinate difference over all frames.
 int first_difference(const Scenario& sc, const std::string& a, const std::string& b, int frames,
-                     const std::vector<ParamOverride>& ov, double* max_diff = nullptr) {
+                     const std::vector<ParamOverride>& ov, double* max_diff = nullptr, bool skip_inert = true) {
   ThreadPool pool(2);
-  auto ma = make(a, sc, ov, pool);
-  auto mb = make(b, sc, ov, pool);
+  auto ma = make(a, sc, ov, pool, skip_inert);
+  auto mb = make(b, sc, ov, pool, skip_inert);
   int first = -1;
   double worst = 0.0;
   for (int f = 0; f < frames; ++f) {
@@ -105,6 +105,27 @@ TEST(HanFused, BitIdenticalWithStagesOff) {
   for (const auto& ov : settings)
     for (const std::string& m : kMethods)
       EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, ov), -1) << m << " " << ov[0].name;
+}
+
+// Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
+// and wake when the head turns, in both implementations.
+TEST(HanFused, BitIdenticalToReferenceThroughSleepAndWake) {
+  Scenario sc = test::builtin("idle", 16);
+  sc.frames = 200;
+  Oscillator turn;
+  turn.kind = Oscillator::Kind::Rotate;
+  turn.amplitude = 0.5;
+  turn.start = 2.0;
+  turn.end = 10.0;
+  sc.head.oscillators = {turn};
+  for (const std::string& m : kMethods) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
+}
+
+// --no-skip (ModelContext::skip_inert off): every stage and term runs, nothing sleeps.
+TEST(HanFused, BitIdenticalToReferenceWithoutSkipping) {
+  Scenario sc = test::builtin("idle", 16);
+  for (const std::string& m : kMethods)
+    EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {{"*", "global_stiffness", 0.0}}, nullptr, false), -1) << m;
 }
 
 // method = 1..3 in every region runs that method whatever the model's own (§6 LOD).

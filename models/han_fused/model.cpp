@@ -33,9 +33,12 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
     p.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
     const float range = static_cast<float>(params.get("global_range", r));
     p.global_ramp = params.get_int("global_ramp", r) != 0;
-    p.global_on = p.global_stiffness != 0.0f && range != 0.0f;
+    // Issue 8: a pass whose stiffness or reach is 0 changes nothing and is not run (unless
+    // ModelContext::skip_inert is off, the reference for that claim).
+    p.global_on = !ctx_.skip_inert || (p.global_stiffness != 0.0f && range != 0.0f);
     p.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
-    p.local_iterations = p.local_stiffness != 0.0f ? params.get_int("local_iterations", r) : 0;
+    p.local_iterations =
+        !ctx_.skip_inert || p.local_stiffness != 0.0f ? params.get_int("local_iterations", r) : 0;
     p.length_iterations = params.get_int("length_iterations", r);
     // global_reach depends on the strand's vertex count: set per block below.
     p.global_reach = range;
@@ -88,6 +91,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
       const bool used = i + static_cast<std::size_t>(l) < j;
       strands[l] = order[used ? i + l : j - 1];
       b.out_offset[l] = used ? rest.strand_begin(strands[l]) : soa::kNoStrand;
+      b.strand[l] = used ? strands[l] : soa::kNoStrand;
     }
     floats += soa::block_floats(b.method, n);
     blocks_.push_back(b);
@@ -183,6 +187,12 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
     threads_[t].last = k;
   }
   scratch_stride_ = soa::kMaxBlocks * soa::scratch_floats(max_n);
+  std::size_t max_block = 0;
+  for (const BlockInfo& b : blocks_) max_block = std::max(max_block, soa::block_floats(b.method, b.n));
+  backup_stride_ = soa::kMaxBlocks * max_block;
+  backup_.assign(backup_stride_ * static_cast<std::size_t>(threads), 0.0f);
+  prev_tmp_.assign(static_cast<std::size_t>(max_n) * static_cast<std::size_t>(threads), Vec4f::Zero());
+  sleep_.reset(rest.strand_count());
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
   substep_.assign(static_cast<std::size_t>(substeps_), soa::Substep{});
   spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
@@ -213,29 +223,91 @@ void HanFusedModel::run_thread(int t) {
   ThreadState& ts = threads_[static_cast<std::size_t>(t)];
   float* out = pos_.data()->data();
   float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
+  float* backup = backup_.data() + backup_stride_ * static_cast<std::size_t>(t);
   for (std::size_t j = ts.first; j < ts.last; ++j) {
     const Job& job = jobs_[j];
     const BlockInfo& first = blocks_[job.first];
     soa::BlockParams p = region_[first.region];
     p.global_reach = p.global_reach * static_cast<float>(first.n);  // range · n, as global_shape
     soa::Block blocks[soa::kMaxBlocks];
+    int asleep = 0, strands = 0;
     for (int i = 0; i < job.count; ++i) {
       const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
       blocks[i] = {data_.data() + b.offset, b.n, b.method, b.out_offset.data(), row_kinds_.data() + b.row_kinds};
+      if (!calm_) continue;
+      for (std::uint32_t s : b.strand)
+        if (s != soa::kNoStrand) {
+          ++strands;
+          asleep += sleep_.asleep(s);
+        }
     }
+    if (calm_ && asleep == strands) continue;  // every strand of the job sleeps
+    if (asleep > 0)
+      for (int i = 0; i < job.count; ++i) {
+        const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
+        std::copy_n(blocks[i].data, soa::block_floats(b.method, b.n), backup + i * backup_stride_ / soa::kMaxBlocks);
+      }
     if (j + 1 < ts.last) prefetch(jobs_[j + 1]);
     if (!job.sampled) {
       kernel_(blocks, job.count, p, frame_, out, scratch, nullptr);
-      continue;
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      kernel_(blocks, job.count, p, frame_, out, scratch, ts.stage_ns.data());
+      ts.sampled_ns +=
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
     }
-    const auto start = std::chrono::steady_clock::now();
-    kernel_(blocks, job.count, p, frame_, out, scratch, ts.stage_ns.data());
-    ts.sampled_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start)
-                         .count();
+    if (asleep == 0) continue;
+    // Put the sleepers' lanes back, every row of every field, and their positions.
+    for (int i = 0; i < job.count; ++i) {
+      const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
+      const float* saved = backup + i * backup_stride_ / soa::kMaxBlocks;
+      const std::size_t rows = soa::block_floats(b.method, b.n) / W;
+      for (int l = 0; l < W; ++l) {
+        if (b.strand[l] == soa::kNoStrand || !sleep_.asleep(b.strand[l])) continue;
+        for (std::size_t r = 0; r < rows; ++r) blocks[i].data[r * W + l] = saved[r * W + l];
+        const float* d = blocks[i].data;
+        const std::size_t nw = static_cast<std::size_t>(b.n) * W;
+        for (int v = 0; v < b.n; ++v) {
+          Vec4f& o = pos_[b.out_offset[l] + static_cast<std::size_t>(v)];
+          const std::size_t k = static_cast<std::size_t>(v) * W + l;
+          o = Vec4f(d[soa::PX * nw + k], d[soa::PY * nw + k], d[soa::PZ * nw + k], d[soa::IW * nw + k]);
+        }
+      }
+    }
   }
 }
 
+// StrandSleep::observe for every awake strand of this thread's jobs, with the previous
+// positions gathered from the blocks (the last substep's, as the reference's prev).
+void HanFusedModel::observe_sleep(int t, float dt) {
+  const ThreadState& ts = threads_[static_cast<std::size_t>(t)];
+  Vec4f* prev = prev_tmp_.data() + prev_tmp_.size() / threads_.size() * static_cast<std::size_t>(t);
+  for (std::size_t j = ts.first; j < ts.last; ++j)
+    for (int i = 0; i < jobs_[j].count; ++i) {
+      const BlockInfo& b = blocks_[jobs_[j].first + static_cast<std::size_t>(i)];
+      const float* d = data_.data() + b.offset;
+      const std::size_t nw = static_cast<std::size_t>(b.n) * W;
+      for (int l = 0; l < W; ++l) {
+        const std::uint32_t s = b.strand[l];
+        if (s == soa::kNoStrand || sleep_.asleep(s)) continue;
+        for (int v = 0; v < b.n; ++v) {
+          const std::size_t k = static_cast<std::size_t>(v) * W + l;
+          prev[v] = Vec4f(d[soa::QX * nw + k], d[soa::QY * nw + k], d[soa::QZ * nw + k], d[soa::IW * nw + k]);
+        }
+        const std::size_t n = static_cast<std::size_t>(b.n);
+        sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(b.out_offset[l], n), std::span<const Vec4f>(prev, n), dt);
+      }
+    }
+}
+
 void HanFusedModel::step(const FrameInput& in, StageTimes& times) {
+  calm_ = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm_ && sleep_.all_asleep()) {
+    // Every strand sleeps: nothing runs (issue 8).
+    for (std::string_view stage : {"integrate", "global_shape", "local_shape", "length", "collision"}) times.skip(stage);
+    return;
+  }
+  const FramePlan plan = plan_frame(in, ctx_);
   const auto start = std::chrono::steady_clock::now();
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
   const std::size_t nc = in.colliders.size();
@@ -274,7 +346,7 @@ void HanFusedModel::step(const FrameInput& in, StageTimes& times) {
     frame_.gravity[c] = in.gravity[c];
     frame_.wind[c] = wind[c];
   }
-  frame_.windy = in.wind.active();  // no wind, no wind term
+  frame_.windy = plan.wind;  // no wind, no wind term
 
   for (ThreadState& ts : threads_) {
     ts.stage_ns.fill(0);
@@ -311,7 +383,17 @@ void HanFusedModel::step(const FrameInput& in, StageTimes& times) {
   report("global_shape", soa::kGlobal, any_global_);
   report("local_shape", soa::kLocal, any_local_);
   report("length", soa::kLength, any_length_);
-  report("collision", soa::kCollision, nc > 0);
+  report("collision", soa::kCollision, plan.collision);
+  if (calm_) {
+    StageTimer t(times, "sleep");
+    if (ctx_.pool)
+      ctx_.pool->parallel_for(threads_.size(), [self, dt](std::size_t b, std::size_t e) {
+        for (std::size_t t = b; t < e; ++t) self->observe_sleep(static_cast<int>(t), dt);
+      });
+    else
+      observe_sleep(0, dt);
+    sleep_.end_observe();
+  }
 }
 
 std::unique_ptr<HairModel> make(han::Method method, const ModelContext& ctx) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/sleep.h"
 #include "kernels/cpu/han_soa.h"
 #include "models/han/model.h"
 
@@ -47,6 +48,7 @@ class HanFusedModel final : public HairModel {
     int n, method;
     std::uint16_t region;
     std::array<std::uint32_t, kernels::han_soa::kLanes> out_offset;
+    std::array<std::uint32_t, kernels::han_soa::kLanes> strand;  // groom index, or kNoStrand
   };
   // One kernel call: up to kMaxBlocks consecutive blocks of one region and vertex count.
   struct Job {
@@ -61,6 +63,7 @@ class HanFusedModel final : public HairModel {
   };
   void run_thread(int t);
   void prefetch(const Job& job) const;
+  void observe_sleep(int t, float dt);
 
   han::Method method_;
   ModelContext ctx_;
@@ -76,6 +79,15 @@ class HanFusedModel final : public HairModel {
   std::vector<Vec4f> pos_;
   int substeps_ = 1;
   bool any_global_ = false, any_local_ = false, any_length_ = false;
+
+  // Sleeping strands (issue 8, core/sleep.h): a block whose strands all sleep is not
+  // run; a block with some asleep runs whole and its sleepers' lanes are put back from
+  // a copy (backup_, per thread), so they stay bit-exactly as they were.
+  StrandSleep sleep_;
+  bool calm_ = false;
+  FloatBuffer backup_;
+  std::size_t backup_stride_ = 0;
+  std::vector<Vec4f> prev_tmp_;  // per thread, max strand length: observe()'s prev
 
   // Per-step input, filled before the parallel pass (capacity reserved in reset()).
   std::vector<kernels::han_soa::Substep> substep_;
