@@ -225,7 +225,10 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
   // segment (k-1, k) is turned towards its rest direction relative to segment
   // (k-2, k-1), read in section frame k-2 (propagated without twist from the head,
   // §3.3) turned so that its normal is that segment: the rest style is the target.
-  // The spring is a torque k * angle * L0^2 at node k-1 acting on segment (k-1, k) and,
+  // The spring is a torque k * angle * L0^2 at node k-1 (L0 the shorter rest length of
+  // the two segments, so that the lateral stiffness it puts on nodes k and k-2, torque /
+  // length^2, stays at most k whatever their ratio: with the longer one, TressFX's curls
+  // of 2 mm edges next to 5 mm ones flew apart) acting on segment (k-1, k) and,
   // in reverse, on segment (k-2, k-1): forces on nodes k and k-2, their negated sum on
   // k-1, so that it neither pushes nor spins the wisp as a whole. The target turns
   // with the whole of segment (k-2, k-1), which takes the reaction, and the torque does
@@ -247,7 +250,8 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     const float sin_angle = axis.norm();
     Vec3f fk = Vec3f::Zero(), fk2 = Vec3f::Zero();
     if (sin_angle > 1e-7f) {
-      const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * s.rest_len[k] * s.rest_len[k];
+      const float l0 = std::min(s.rest_len[k], s.rest_len[k - 1]);
+      const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * l0 * l0;
       const Vec3f a = axis / sin_angle;
       fk = (torque / len) * a.cross(t);
       fk2 = (torque / len_prev) * a.cross(t_prev);
