@@ -171,12 +171,15 @@ void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend) {
   if (ref.squaredNorm() < 1e-8f) ref = n0.cross(Vec3f::UnitY());
   s.rest_e1[w] = ref.normalized();
   wisp_frames(s, w, s.rest_e1[w]);
-  int free_index = 0;
+  // The weight ramps with the distance, in nodes, to the nearest pinned node: strands
+  // pinned at both ends (TressFX) blend towards the head at the tip as at the root.
   for (std::uint32_t k = b; k < e; ++k) {
     s.rest_fe1[k] = s.e1[k];
     s.rest_fe2[k] = s.e2[k];
-    s.frame_weight[k] = s.pinned[k] ? 0.0f
-                                    : std::min(1.0f, static_cast<float>(++free_index) / static_cast<float>(root_blend + 1));
+    std::uint32_t nearest = e - b;
+    for (std::uint32_t j = b; j < e; ++j)
+      if (s.pinned[j]) nearest = std::min(nearest, k > j ? k - j : j - k);
+    s.frame_weight[k] = std::min(1.0f, static_cast<float>(nearest) / static_cast<float>(root_blend + 1));
   }
   for (std::uint32_t k = b + 2; k < e; ++k) {
     // In the frame of segment (k-2, k-1): section frame k-2 turned so that its normal

@@ -344,17 +344,41 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t nb = sys_.node_begin[strand_wisp_[s]];
       const std::uint32_t vb = rest_.strand_begin(s);
+      const std::uint32_t n = rest_.strand_size(s);
+      auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
+      auto point = [&](std::uint32_t i) { return k::strand_point(sys_, nb + i, coord_[vb + i], head_rot); };
+      // Root to tip, each free vertex anchored to the last pinned one before it ...
       Vec3f anchor = Vec3f::Zero();
-      for (std::uint32_t i = 0; i < rest_.strand_size(s); ++i) {
-        const Vec4f& r = rest_.positions[vb + i];
+      int last = -1;
+      bool pinned_after_free = false;
+      for (std::uint32_t i = 0; i < n; ++i) {
         Vec4f& out = pos_[vb + i];
-        if (r.w() == 0.0f) {
-          out.head<3>() = head * xyz(r);
-          anchor = xyz(out) - k::strand_point(sys_, nb + i, coord_[vb + i], head_rot);
+        if (pinned(i)) {
+          out.head<3>() = head * xyz(rest_.positions[vb + i]);
+          anchor = xyz(out) - point(i);
+          pinned_after_free = pinned_after_free || (last >= 0 && static_cast<std::uint32_t>(last) + 1 < i) ||
+                              (last < 0 && i > 0);
+          last = static_cast<int>(i);
           continue;
         }
         const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
-        out.head<3>() = k::strand_point(sys_, nb + i, coord_[vb + i], head_rot) + (1.0f - wgt) * anchor;
+        out.head<3>() = point(i) + (1.0f - wgt) * anchor;
+      }
+      if (!pinned_after_free) continue;
+      // ... or, where a pinned vertex follows nearer (a strand pinned at both ends), to it.
+      int next = -1;
+      for (std::uint32_t i = n; i-- > 0;) {
+        if (pinned(i)) {
+          anchor = xyz(pos_[vb + i]) - point(i);
+          next = static_cast<int>(i);
+          continue;
+        }
+        if (next < 0) continue;
+        int prev = static_cast<int>(i) - 1;
+        while (prev >= 0 && !pinned(static_cast<std::uint32_t>(prev))) --prev;
+        if (prev >= 0 && static_cast<int>(i) - prev <= next - static_cast<int>(i)) continue;
+        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
+        pos_[vb + i].head<3>() = point(i) + (1.0f - wgt) * anchor;
       }
     }
   };
