@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace hairbench {
 namespace {
@@ -227,12 +228,7 @@ TEST(PlanteWisp, ReturnsTowardRestShapeAfterHeadStops) {
 
 // Every shipped scenario runs without NaN or blow-up of the simulation itself: finite
 // positions, skeleton segments within 50% of their rest length (thinned groom, first
-// 60 frames). Known difference: on `ponytail` the rebuilt strands - not the skeleton -
-// exceed the harness's 50% edge-length criterion (hairbench compare reports the model
-// unstable there): its front and top strands turn flat onto the scalp within 1.2 cm, the
-// wisps lying on the head get their lower envelope masses squashed to the 25% floor,
-// and a strand interpolated between a squashed and an unsquashed section is stretched
-// (max strand edge error 0.52-0.67 over the run while the skeleton strain stays < 5%).
+// 60 frames).
 TEST(PlanteWisp, NoNaNOnEveryBuiltinScenario) {
   for (const auto& file : test::procedural_builtin_scenarios()) {
     const Scenario sc = builtin(file.stem().string(), 16);
@@ -250,6 +246,39 @@ TEST(PlanteWisp, NoNaNOnEveryBuiltinScenario) {
     }
     EXPECT_TRUE(finite) << file;
     EXPECT_LT(strain, 0.5) << file;
+  }
+}
+
+// §3.4/§5.2: the rebuilt strands - the model's positions - keep their edges within the
+// harness's 50% bound through the scenarios where they used to break it (issue 5), for
+// the whole run and with every 4th strand (wisps of the thinned groom are sparser, so
+// wider, than the full groom's). Where the error comes from, and its bound: the skeleton
+// springs stretch a segment by < 10% (axial stiffness, bending springs stiff enough to
+// keep node bends moderate); a strand's offsets in its sections are at most
+// wisp_width_max = 0.5 rest edges, so a change of bend phi at a node moves a strand
+// point axially by about 0.5 tan(phi/2) edges; the envelope's scale lies in [0.25, 2];
+// the first free edge is anchored to the strand's own root (rebuild). Measured (max
+// edge error / worst-frame RMS): ponytail 0.19 / 0.026, spin_fast 0.23 / 0.062,
+// tilt_upside_down 0.20 / 0.020, wind_gust 0.06 / 0.019 (before the fix: 0.5-1.4 max,
+// unstable). The bounds, 0.35 and 0.09, are 1.5 times the largest measured values:
+// well inside the harness's 50%, and tight enough to catch the old failure.
+TEST(PlanteWisp, RebuiltStrandsKeepTheirEdgeLengths) {
+  for (const char* name : {"ponytail", "spin_fast", "tilt_upside_down", "wind_gust"}) {
+    const Scenario sc = builtin(name, 4);
+    plante::PlanteWispModel m(ModelContext{nullptr});
+    m.reset(sc.groom, plante_params(sc.groom));
+    const metrics::RestInfo rest(sc.groom);
+    StageTimes times;
+    double worst = 0.0, worst_rms = 0.0;
+    for (int f = 0; f < sc.frames; ++f) {
+      m.step(frame_input(sc, f), times);
+      const metrics::LengthError e = metrics::length_error(rest, m.positions());
+      worst = std::max(worst, e.max);
+      worst_rms = std::max(worst_rms, e.rms);
+    }
+    EXPECT_LT(worst, 0.35) << name;
+    EXPECT_LT(worst_rms, 0.09) << name;
+    std::printf("%s: edge length error max %.3f, worst-frame RMS %.4f\n", name, worst, worst_rms);
   }
 }
 

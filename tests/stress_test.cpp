@@ -23,13 +23,6 @@ std::vector<std::string> all_models() {
   return names;
 }
 
-// Known gap (issue 5, open): plante_wisp's rebuilt strands stretch past the 50% edge
-// bound where wisps bend sharply or are squashed (a 20-strand shake already does it at
-// t = 0.017 s; the vertical and collider grooms too) while its skeleton stays intact.
-// For it the tests assert what holds: the failure is a stretch, never a NaN.
-bool known_stretch_gap(const std::string& model) { return model == "plante_wisp"; }
-bool is_stretch(const std::string& reason) { return reason.rfind("edge length error above 50%", 0) == 0; }
-
 TEST(EnergyGrowthCheck, SustainedGrowthWithTheHeadStillFails) {
   // L-bar 0.25 m, g 9.81: the threshold is 0.05 * 9.81 * 0.25 = 0.123 J/kg per window.
   EnergyGrowthCheck check(0.25, 9.81);
@@ -58,10 +51,6 @@ TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
   ASSERT_EQ(r.degenerate.size(), 5 * opt.models.size());
   for (const DegenerateResult& d : r.degenerate) {
     SCOPED_TRACE(d.model + " on " + d.name + ": " + d.reason);
-    if (known_stretch_gap(d.model) && d.status == "unstable") {
-      EXPECT_TRUE(is_stretch(d.reason));
-      continue;
-    }
     EXPECT_NE(d.status, "unstable");
     if (d.name == "zero_length_edge") {
       // Refused at load with the groom and the field named.
@@ -91,11 +80,7 @@ TEST(Stress, ShortSetEscalatesUntilFailureAndKeepsTheBaseStable) {
       EXPECT_EQ(c.stable, c.reason.empty());
       // The base scenario's own time step (1/60 s) is where every model is stable.
       if (a.axis == "time_step" && c.value == 1.0 / 60) {
-        if (known_stretch_gap(a.model) && !c.stable) {
-          EXPECT_TRUE(is_stretch(c.reason)) << c.reason;
-        } else {
-          EXPECT_TRUE(c.stable) << c.reason;
-        }
+        EXPECT_TRUE(c.stable) << c.reason;
       }
     }
     // last stable < first failing, both from the tried values, when both exist.

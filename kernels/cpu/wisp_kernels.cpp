@@ -12,6 +12,14 @@ namespace {
 // stopped, which bounds the spring's slope at 16 times its rest value and keeps the
 // explicit integration (§5.3) stable at the default 1000 Hz.
 constexpr float kMinRadiusFraction = 0.25f;
+// The stretch branch is soft (radial_stretch) and a skeleton mass jerked by a contact
+// flings its envelope masses outwards (inertial force, wisp_forces_and_velocities): on
+// a groom starting inside a collider they reached 4 times the rest radius within a
+// frame, and the strands, whose section offsets scale with the envelope (§5.2), moved
+// by 3 rest radii between neighbouring sections. Beyond twice the rest radius the
+// envelope mass is stopped: a strand's offset (at most wisp_width_max edges) then moves
+// by at most as much again.
+constexpr float kMaxRadiusFraction = 2.0f;
 
 Vec3f unit_or(const Vec3f& v, const Vec3f& fallback) {
   const float n2 = v.squaredNorm();
@@ -96,6 +104,11 @@ SectionFrame section_frame(const WispSystem& s, std::uint32_t k, float sfrac, co
   return f;
 }
 
+float section_weight(const WispSystem& s, std::uint32_t k, float sfrac) {
+  const std::uint32_t j = sfrac > 0.0f ? k + 1 : sfrac < 0.0f ? k - 1 : k;
+  return lerp(s.frame_weight[k], s.frame_weight[j], std::abs(sfrac));
+}
+
 Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& c, const Eigen::Matrix3f& head_rot) {
   const SectionFrame f = section_frame(s, k, c.x(), head_rot);
   const float a = c.y() * (c.y() >= 0.0f ? f.scale_a[0] : f.scale_a[1]);
@@ -158,16 +171,23 @@ void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend) {
   if (ref.squaredNorm() < 1e-8f) ref = n0.cross(Vec3f::UnitY());
   s.rest_e1[w] = ref.normalized();
   wisp_frames(s, w, s.rest_e1[w]);
-  int free_index = 0;
+  // The weight ramps with the distance, in nodes, to the nearest pinned node: strands
+  // pinned at both ends (TressFX) blend towards the head at the tip as at the root.
   for (std::uint32_t k = b; k < e; ++k) {
     s.rest_fe1[k] = s.e1[k];
     s.rest_fe2[k] = s.e2[k];
-    s.frame_weight[k] = s.pinned[k] ? 0.0f
-                                    : std::min(1.0f, static_cast<float>(++free_index) / static_cast<float>(root_blend + 1));
+    std::uint32_t nearest = e - b;
+    for (std::uint32_t j = b; j < e; ++j)
+      if (s.pinned[j]) nearest = std::min(nearest, k > j ? k - j : j - k);
+    s.frame_weight[k] = std::min(1.0f, static_cast<float>(nearest) / static_cast<float>(root_blend + 1));
   }
   for (std::uint32_t k = b + 2; k < e; ++k) {
+    // In the frame of segment (k-2, k-1): section frame k-2 turned so that its normal
+    // is that segment (see the bending springs in wisp_forces_and_velocities).
     const Vec3f t = unit_or(s.rest_x[k] - s.rest_x[k - 1], s.n[k - 1]);
-    s.bend_local[k] = Vec3f(t.dot(s.e1[k - 2]), t.dot(s.e2[k - 2]), t.dot(s.n[k - 2]));
+    const Vec3f t_prev = unit_or(s.rest_x[k - 1] - s.rest_x[k - 2], s.n[k - 2]);
+    const Vec3f tl = minimal_rotate(t_prev, s.n[k - 2], t);
+    s.bend_local[k] = Vec3f(tl.dot(s.e1[k - 2]), tl.dot(s.e2[k - 2]), tl.dot(s.n[k - 2]));
   }
 }
 
@@ -205,11 +225,21 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k] -= f * t;
   }
   // Damped bending springs whose force grows linearly with the bending angle (§3.2):
-  // segment (k-1, k) is turned towards its rest direction in section frame k-2, which
-  // is propagated without twist from the head (§3.3), so the rest style is the target.
-  // The spring is a torque k * angle at node k-1 acting on segment (k-1, k) and, in
-  // reverse, on segment (k-2, k-1): forces on nodes k and k-2, their negated sum on
-  // k-1, so that it neither pushes nor spins the wisp as a whole.
+  // segment (k-1, k) is turned towards its rest direction relative to segment
+  // (k-2, k-1), read in section frame k-2 (propagated without twist from the head,
+  // §3.3) turned so that its normal is that segment: the rest style is the target.
+  // The spring is a torque k * angle * L0^2 at node k-1 (L0 the shorter rest length of
+  // the two segments, so that the lateral stiffness it puts on nodes k and k-2, torque /
+  // length^2, stays at most k whatever their ratio: with the longer one, TressFX's curls
+  // of 2 mm edges next to 5 mm ones flew apart) acting on segment (k-1, k) and,
+  // in reverse, on segment (k-2, k-1): forces on nodes k and k-2, their negated sum on
+  // k-1, so that it neither pushes nor spins the wisp as a whole. The target turns
+  // with the whole of segment (k-2, k-1), which takes the reaction, and the torque does
+  // not grow with stretch, so the spring derives from the energy k L0^2 angle^2 / 2 (up
+  // to the frame's twist about the segment): read in the bisecting section frame
+  // itself, the target turned with only half of that segment and half of the one
+  // before, which takes no reaction - a follower load whose flutter grew from rounding
+  // on a still head without gravity above k ~ 1e4 at 1000 Hz.
   for (std::uint32_t k = b + 2; k < e; ++k) {
     const Vec3f d = s.x[k] - s.x[k - 1];
     const Vec3f d_prev = s.x[k - 1] - s.x[k - 2];
@@ -217,12 +247,14 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     if (!(len > 0.0f) || !(len_prev > 0.0f)) continue;
     const Vec3f t = d / len, t_prev = d_prev / len_prev;
     const Vec3f& bl = s.bend_local[k];
-    const Vec3f target = bl.x() * s.e1[k - 2] + bl.y() * s.e2[k - 2] + bl.z() * s.n[k - 2];
+    const Vec3f target =
+        minimal_rotate(s.n[k - 2], t_prev, bl.x() * s.e1[k - 2] + bl.y() * s.e2[k - 2] + bl.z() * s.n[k - 2]);
     const Vec3f axis = t.cross(target);
     const float sin_angle = axis.norm();
     Vec3f fk = Vec3f::Zero(), fk2 = Vec3f::Zero();
     if (sin_angle > 1e-7f) {
-      const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * s.rest_len[k] * len;
+      const float l0 = std::min(s.rest_len[k], s.rest_len[k - 1]);
+      const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * l0 * l0;
       const Vec3f a = axis / sin_angle;
       fk = (torque / len) * a.cross(t);
       fk2 = (torque / len_prev) * a.cross(t_prev);
@@ -283,13 +315,16 @@ void wisp_positions(WispSystem& s, std::size_t w, const Vec3f& root_e1, float h)
   wisp_frames(s, w, root_e1);
   for (std::uint32_t k = b; k < e; ++k) {
     if (s.pinned[k]) continue;
-    const float r_min = kMinRadiusFraction * s.r_rest[k];
+    const float r_min = kMinRadiusFraction * s.r_rest[k], r_max = kMaxRadiusFraction * s.r_rest[k];
     for (int q = 0; q < kEnvelopePerSection; ++q) {
       const std::size_t i = kEnvelopePerSection * k + q;
       s.r[i] += h * s.rdot[i];
       if (s.r[i] < r_min) {
         s.r[i] = r_min;
         s.rdot[i] = std::max(s.rdot[i], 0.0f);
+      } else if (s.r[i] > r_max) {
+        s.r[i] = r_max;
+        s.rdot[i] = std::min(s.rdot[i], 0.0f);
       }
     }
   }
@@ -311,25 +346,71 @@ int nearest_sphere(std::span<const Vec4f> spheres, const Vec3f& p, float& gap) {
   return best;
 }
 
+// Where a skeleton mass at x inside a sphere (centre c) is moved to, on the sphere of
+// radius R around c, by the penetration reaction (§4.2). The wisp is processed root to
+// tip and the mass entered the body along its axial spring from `prev`, which is
+// outside: of the points of that sphere it is moved to the one nearest x at the
+// spring's rest length `len` from prev, so that a mass found deep inside (a body that moved fast, a
+// groom that starts inside) comes out without stretching its segment - moved straight
+// out, a mass 2 cm inside stretched a 1.7 cm segment by half and the strands rebuilt on
+// it past the 50% edge bound. prev may lie on that sphere itself (pushed there at this
+// detection). When no such point exists (prev deep inside, or too far) the mass is
+// moved straight out.
+Vec3f push_out(const Vec3f& c, float R, const Vec3f& prev, const Vec3f& x, float len) {
+  const Vec3f radial = c + R * unit_or(x - c, Vec3f::UnitY());
+  const Vec3f pc = prev - c;
+  const float d = pc.norm();
+  if (!(d > 0.0f) || !(len > 0.0f)) return radial;
+  // The circle where the sphere |q - c| = R meets |q - prev| = len: centre c + a u,
+  // radius rho, in the plane normal to u.
+  const Vec3f u = pc / d;
+  const float a = (R * R - len * len + d * d) / (2.0f * d);
+  const float rho2 = R * R - a * a;
+  if (!(rho2 >= 0.0f)) return radial;
+  const Vec3f xc = x - c;
+  const Vec3f lateral = unit_or(xc - xc.dot(u) * u, u.unitOrthogonal());
+  return c + a * u + std::sqrt(rho2) * lateral;
+}
+
 }  // namespace
 
 void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const Vec3f& root_e1, float threshold) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   // Skeleton first, root to tip: the root is outside the body, so a mass found inside
   // entered it during the last steps (§4.2).
+  // A mass after one that was moved is drawn back along its axial spring to no more
+  // than its rest length, so that the reaction carries the rest of the wisp along
+  // instead of tearing the spring (it may then be found inside, and moved in turn).
+  bool prev_moved = false;
   for (std::uint32_t k = b; k < e; ++k) {
     s.node_body[k] = -1;
-    if (s.pinned[k]) continue;
+    if (s.pinned[k]) {
+      prev_moved = false;
+      continue;
+    }
+    bool moved = false;
+    if (prev_moved) {
+      const Vec3f d = s.x[k] - s.x[k - 1];
+      const float len = d.norm();
+      if (len > s.rest_len[k]) {
+        s.x[k] = s.x[k - 1] + d * (s.rest_len[k] / len);
+        moved = true;
+      }
+    }
     float gap;
     const int i = nearest_sphere(body.spheres, s.x[k], gap);
-    if (i < 0 || gap >= threshold) continue;
-    s.node_body[k] = i;
-    if (gap >= 0.0f) continue;
-    const Vec3f c = body.spheres[i].head<3>();
-    const Vec3f nrm = unit_or(s.x[k] - c, Vec3f::UnitY());
-    s.x[k] = c + nrm * (body.spheres[i].w() + 0.9f * threshold);
-    const float vn = (s.v[k] - body.surface_velocity(i, s.x[k])).dot(nrm);
-    if (vn < 0.0f) s.v[k] -= vn * nrm;
+    if (i >= 0 && gap < threshold) {
+      s.node_body[k] = i;
+      if (gap < 0.0f) {
+        const Vec3f c = body.spheres[i].head<3>();
+        s.x[k] = push_out(c, body.spheres[i].w() + 0.9f * threshold, s.x[k > b ? k - 1 : k], s.x[k], s.rest_len[k]);
+        const Vec3f nrm = unit_or(s.x[k] - c, Vec3f::UnitY());
+        const float vn = (s.v[k] - body.surface_velocity(i, s.x[k])).dot(nrm);
+        if (vn < 0.0f) s.v[k] -= vn * nrm;
+        moved = true;
+      }
+    }
+    prev_moved = moved;
   }
   wisp_frames(s, w, root_e1);
   // Then the envelope masses, each along its half-line.

@@ -20,7 +20,7 @@ struct WispParams {
   float air_drag = 5.0f;            // 1/s, on every mass's absolute velocity (§5.1 "air resistance")
   float axial_stiffness = 4e5f;     // 1/s^2 per metre of stretch (§3.2 linear axial springs)
   float axial_damping = 40.0f;      // 1/s on the relative axial velocity
-  float bending_stiffness = 5e3f;   // 1/s^2: lateral acceleration = k * angle * rest length (§3.2)
+  float bending_stiffness = 1e5f;   // 1/s^2: lateral acceleration = k * angle * rest length (§3.2)
   float bending_damping = 60.0f;    // 1/s on the relative lateral velocity
   float envelope_mass = 0.1f;       // envelope mass / skeleton mass (§3.3 "much lighter")
   float radial_stiffness = 5e4f;    // 1/s^2, compression branch at small strain (§3.3)
@@ -53,7 +53,7 @@ struct WispSystem {
   std::vector<Vec3f> rest_x;      // head rest frame
   std::vector<std::uint8_t> pinned;
   std::vector<float> rest_len;    // segment (k-1, k), stored at k (0 at a wisp's first node)
-  std::vector<Vec3f> bend_local;  // rest direction of segment (k-1, k) in section frame k-2
+  std::vector<Vec3f> bend_local;  // rest direction of segment (k-1, k) in frame k-2 turned onto segment (k-2, k-1)
   // Section frames (§3.3): e1, e2 span the plane bisecting the adjacent segments, n its
   // normal; propagated root to tip by minimal rotation from the head-attached root frame.
   std::vector<Vec3f> e1, e2, n;
@@ -110,6 +110,8 @@ inline Vec3f envelope_point(const WispSystem& s, std::size_t k, int q) {
 // strand edges by up to radius x angle - more than the edge itself for a centimetre-wide
 // wisp swinging by a radian.
 Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& coord, const Eigen::Matrix3f& head_rot);
+// frame_weight interpolated like the section of strand_point at coordinate sfrac.
+float section_weight(const WispSystem& s, std::uint32_t k, float sfrac);
 // The coordinates of p relative to node k of wisp w in the current state, exact for
 // strand_point when the envelope is at its rest radii.
 Vec4f strand_coord(const WispSystem& s, std::size_t w, std::uint32_t k, const Vec3f& p,
@@ -148,7 +150,7 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
                                 const Wind& wind, float h);
 
 // §5.1 step 4: x += v h for the skeleton, root to tip, then the new section frames, then
-// r += rdot h for the envelope (kept above a tenth of its rest radius).
+// r += rdot h for the envelope (kept within 0.25 and 2 times its rest radius).
 void wisp_positions(WispSystem& s, std::size_t w, const Vec3f& root_e1, float h);
 
 // ---- Wisp-body interactions (§4.2) -------------------------------------------------

@@ -76,9 +76,32 @@ std::vector<std::vector<std::uint32_t>> kmeans_strands(const Groom& g, const std
   return out;
 }
 
+// Widest distance of a cluster's strands from their mean curve, over all vertices.
+float cluster_width(const Groom& g, const std::vector<std::uint32_t>& c) {
+  const std::size_t n = g.strand_size(c[0]);
+  float widest = 0.0f;
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3f mean = Vec3f::Zero();
+    for (std::uint32_t s : c) mean += xyz(g.positions[g.strand_begin(s) + i]);
+    mean /= static_cast<float>(c.size());
+    for (std::uint32_t s : c) widest = std::max(widest, (xyz(g.positions[g.strand_begin(s) + i]) - mean).norm());
+  }
+  return widest;
+}
+
+// Mean rest edge length of a cluster's strands.
+float cluster_edge(const Groom& g, const std::vector<std::uint32_t>& c) {
+  double sum = 0.0;
+  std::size_t edges = 0;
+  for (std::uint32_t s : c)
+    for (std::uint32_t i = g.strand_begin(s) + 1; i < g.strand_begin(s) + g.strand_size(s); ++i, ++edges)
+      sum += (xyz(g.positions[i]) - xyz(g.positions[i - 1])).norm();
+  return edges ? static_cast<float>(sum / static_cast<double>(edges)) : 0.0f;
+}
+
 }  // namespace
 
-void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend) {
+void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max) {
   // Wisps only gather strands of one region (they share its parameters) and of one
   // vertex count (a wisp's nodes are its strands' vertices).
   std::map<std::pair<std::uint16_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
@@ -92,7 +115,29 @@ void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp
   for (const auto& [key, strands] : groups) {
     const double share = static_cast<double>(strands.size());
     const double want = wisps > 0 ? wisps * share / total : share / strands_per_wisp;
-    for (auto& c : kmeans_strands(rest, strands, static_cast<std::size_t>(std::max(1.0, std::round(want))))) {
+    // A wisp's strands keep fixed offsets in its sections (§5.2), so a section turning
+    // by an angle moves them axially by up to the wisp's radius times that angle: an edge
+    // of a strand at radius r across a node whose bend changes by phi changes by about
+    // 2 r tan(phi/2). Wisps wider than `width_max` rest edges (from their strands' mean
+    // curve) are split in two until none is; the paper's wisps are "mostly as wide as
+    // they are long" (§4.1, footnote 1), i.e. r up to half a segment.
+    std::vector<std::vector<std::uint32_t>> todo =
+        kmeans_strands(rest, strands, static_cast<std::size_t>(std::max(1.0, std::round(want))));
+    std::vector<std::vector<std::uint32_t>> clusters;
+    while (!todo.empty()) {
+      std::vector<std::uint32_t> c = std::move(todo.back());
+      todo.pop_back();
+      auto halves = c.size() > 1 && cluster_width(rest, c) > width_max * cluster_edge(rest, c)
+                        ? kmeans_strands(rest, c, 2)
+                        : std::vector<std::vector<std::uint32_t>>{};
+      if (halves.size() == 2) {
+        for (auto& half : halves) todo.push_back(std::move(half));
+      } else {
+        clusters.push_back(std::move(c));  // narrow enough, or strands k-means cannot part
+      }
+    }
+    std::sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) { return a.front() < b.front(); });
+    for (auto& c : clusters) {
       const std::uint32_t n = key.second;
       for (std::uint32_t i = 0; i < n; ++i) {
         Vec3f mean = Vec3f::Zero();
@@ -165,7 +210,8 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   interaction_hz_ = params.get("interaction_hz");
   threads_min_wisps_ = params.get_int("threads_min_wisps");
 
-  cluster(rest, params.get_int("wisps"), params.get_int("strands_per_wisp"), params.get_int("root_blend"));
+  cluster(rest, params.get_int("wisps"), params.get_int("strands_per_wisp"), params.get_int("root_blend"),
+          static_cast<float>(params.get("wisp_width_max")));
   const float r_min = static_cast<float>(params.get("wisp_radius_min"));
   for (float& r : sys_.r_rest) r = std::max(r, r_min);
   for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
@@ -286,20 +332,57 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
 // §5.2: the strands are drawn at fixed positions relative to the wisp envelope: the
 // section's origin is the skeleton, its axes and scale factors come from the four
 // envelope masses (kernels::strand_point).
+//
+// A strand's pinned vertices follow the head, but they lie up to half a segment ahead of
+// or behind the wisp's pinned nodes along its axis (the wisp's nodes are its strands'
+// mean vertices): when the wisp's first free segment turns by an angle about its pinned
+// node, the section point of a pinned vertex turns with it while the vertex does not,
+// and the first free edge changed length by up to half a segment times that angle
+// (0.5-1.4 of its rest length on ponytail, spin_fast, tilt_upside_down, wind_gust).
+// The gap between the last pinned vertex and its section point (`anchor`) is carried
+// by the free vertices, fading with the section weight that already blends the axes
+// near the root (root_blend), so the strand stays attached to its root.
 void PlanteWispModel::rebuild(const Affine3f& head) {
   const Eigen::Matrix3f head_rot = head.linear();
   auto body = [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t nb = sys_.node_begin[strand_wisp_[s]];
       const std::uint32_t vb = rest_.strand_begin(s);
-      for (std::uint32_t i = 0; i < rest_.strand_size(s); ++i) {
-        const Vec4f& r = rest_.positions[vb + i];
+      const std::uint32_t n = rest_.strand_size(s);
+      auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
+      auto point = [&](std::uint32_t i) { return k::strand_point(sys_, nb + i, coord_[vb + i], head_rot); };
+      // Root to tip, each free vertex anchored to the last pinned one before it ...
+      Vec3f anchor = Vec3f::Zero();
+      int last = -1;
+      bool pinned_after_free = false;
+      for (std::uint32_t i = 0; i < n; ++i) {
         Vec4f& out = pos_[vb + i];
-        if (r.w() == 0.0f) {
-          out.head<3>() = head * xyz(r);
+        if (pinned(i)) {
+          out.head<3>() = head * xyz(rest_.positions[vb + i]);
+          anchor = xyz(out) - point(i);
+          pinned_after_free = pinned_after_free || (last >= 0 && static_cast<std::uint32_t>(last) + 1 < i) ||
+                              (last < 0 && i > 0);
+          last = static_cast<int>(i);
           continue;
         }
-        out.head<3>() = k::strand_point(sys_, nb + i, coord_[vb + i], head_rot);
+        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
+        out.head<3>() = point(i) + (1.0f - wgt) * anchor;
+      }
+      if (!pinned_after_free) continue;
+      // ... or, where a pinned vertex follows nearer (a strand pinned at both ends), to it.
+      int next = -1;
+      for (std::uint32_t i = n; i-- > 0;) {
+        if (pinned(i)) {
+          anchor = xyz(pos_[vb + i]) - point(i);
+          next = static_cast<int>(i);
+          continue;
+        }
+        if (next < 0) continue;
+        int prev = static_cast<int>(i) - 1;
+        while (prev >= 0 && !pinned(static_cast<std::uint32_t>(prev))) --prev;
+        if (prev >= 0 && static_cast<int>(i) - prev <= next - static_cast<int>(i)) continue;
+        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
+        pos_[vb + i].head<3>() = point(i) + (1.0f - wgt) * anchor;
       }
     }
   };

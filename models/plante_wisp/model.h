@@ -37,7 +37,7 @@ class PlanteWispModel final : public HairModel {
   std::span<const kernels::WispContact> contacts() const { return contacts_; }
 
  private:
-  void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend);
+  void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max);
   template <class F>
   void for_each_wisp(F&& f);
   void detect_self_interactions();

@@ -11,11 +11,16 @@
 // Stiffnesses are accelerations per metre (1/s^2) of the mass they act on, dampings
 // 1/s: the defaults keep the explicit integration stable at 1000 Hz with the highest
 // axial mode at omega h ~ 1.3 (< 2), and hold a 16-vertex, 25 cm wisp within ~2% of its
-// rest length under gravity. The bending springs, whose targets turn with the frames
-// propagated from the root, go unstable at 1000 Hz above about 1e4 1/s^2 (measured on
-// `idle` without gravity); 5e3 leaves the hair sagging onto the scalp under gravity
-// (rest_shape_error ~0.13 L-bar on `idle`: nothing but bending holds the style, §3.2).
-// They are not the paper's (it gives none).
+// rest length under gravity. The bending springs derive from an energy (see
+// wisp_forces_and_velocities); their zigzag mode has omega^2 ~ 16 k, so explicit
+// integration at 1000 Hz holds up to k ~ 2.5e5 (measured on `idle` without gravity:
+// still at 2e5, blown up at 5e5). 1e5 (omega h ~ 1.3) is the stiffest default with that
+// margin; it holds the style against metric gravity far better than the old 5e3
+// (rest_shape_error on `idle` 0.08 L-bar instead of 0.13), though a 25 cm wisp of unit
+// node masses would need ~6e5 to hold its root within 0.1 rad (nothing but bending
+// holds the style, §3.2). Stiffer bending also bounds the bend changes at the nodes,
+// which the rebuilt strands turn into edge length error (wisp_width_max). None of
+// these numbers are the paper's (it gives none).
 #pragma once
 
 #include "core/params.h"
@@ -24,10 +29,12 @@
 
 namespace hairbench::plante {
 
-inline constexpr std::array<ParamSpec, 24> kParams{{
+inline constexpr std::array<ParamSpec, 25> kParams{{
     {"strands_per_wisp", 3, 1, 10000, true,
      "groom strands per wisp when `wisps` is 0: wisps = round(strands / strands_per_wisp) (§3.1)"},
     {"wisps", 0, 0, 1000000, true, "number of wisps (0: from strands_per_wisp); root-weighted k-means on the rest strands"},
+    {"wisp_width_max", 0.5, 0.01, 1000, false,
+     "wisps wider than this many rest edges (strand distance from their mean curve) are split (§4.1 fn. 1)"},
     {"wisp_radius_min", 0.003, 1e-5, 1.0, false,
      "smallest rest envelope radius, metres (a wisp of one strand has no spread of its own)"},
     {"root_blend", 3, 0, 64, true,
@@ -38,7 +45,7 @@ inline constexpr std::array<ParamSpec, 24> kParams{{
     {"air_drag", 5.0, 0, 1000, false, "air resistance on every mass, 1/s (§5.1 step 1)"},
     {"axial_stiffness", 4e5, 0, 1e7, false, "linear axial springs of the skeleton, 1/s^2 (§3.2)"},
     {"axial_damping", 40, 0, 1000, false, "damping of the axial springs, 1/s (§3.2)"},
-    {"bending_stiffness", 5e3, 0, 1e6, false,
+    {"bending_stiffness", 1e5, 0, 1e6, false,
      "bending springs: lateral acceleration = k * angle * segment rest length, 1/s^2 (§3.2)"},
     {"bending_damping", 60, 0, 1000, false, "damping of the relative lateral velocity, 1/s (§3.2)"},
     {"envelope_mass", 0.1, 1e-3, 1, false, "envelope mass / skeleton mass (§3.3: much lighter)"},
