@@ -95,20 +95,12 @@ void within_factor(ReproduceCheck& c, double f) {
 
 // --- Timing one model on one scenario ---------------------------------------------------
 
-struct Timed {
-  double step_ms = kNaN;  // median over the timed frames: wall time, or device time on a GPU
-  std::string device;
-  bool unstable = false;
-};
-
-// Steps `frames` + 1 frames; the first (caches, pipeline compilation) is not timed.
-Timed time_model(const ModelInfo& info, const Scenario& sc, int frames, ThreadPool& pool, const std::string& device) {
+// Median time of one step over `frames` frames: wall time, or the device time on a GPU.
+// One frame more is stepped first, untimed (caches, pipeline compilation).
+double time_model(const ModelInfo& info, const Scenario& sc, int frames, ThreadPool& pool, const std::string& device) {
   std::unique_ptr<HairModel> model = make_model(info, sc, resolve_params(info, sc, {}), pool, device);
-  const metrics::RestInfo rest(sc.groom);
   StageTimes times;
   std::vector<double> ms;
-  Timed t;
-  t.device = model->backend().device;
   for (int f = 0; f <= frames; ++f) {
     const FrameInput in = frame_input(sc, f % sc.frames);
     times.clear();
@@ -117,9 +109,7 @@ Timed time_model(const ModelInfo& info, const Scenario& sc, int frames, ThreadPo
     const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (f > 0) ms.push_back(model->last_gpu_ms().value_or(wall));
   }
-  t.unstable = !metrics::blowup_reason(rest, model->positions(), Vec3f::Zero()).empty();
-  t.step_ms = median(ms);
-  return t;
+  return median(ms);
 }
 
 // --- Han & Harada 2012 ---------------------------------------------------------------------
@@ -202,13 +192,13 @@ json reproduce_han(const Ctx& c) {
     const Scenario& sc = scen.at(model);
     const double passes = resolve_params(*find_model("han_" + method), sc, {}).get("substeps");
     c.log("han2012 table 2: " + model + " " + method + " (cpu)");
-    const Timed cpu = time_model(*find_model("han_" + method), sc, cpu_frames, c.pool, "");
+    const double cpu = time_model(*find_model("han_" + method), sc, cpu_frames, c.pool, "");
     double dev = kNaN;
     if (vk.available) {
       c.log("han2012 table 2: " + model + " " + method + " (" + vk.name + ")");
-      dev = time_model(*find_model("han_" + method + "_vk"), sc, vk_frames, c.pool, c.opt.device).step_ms / passes;
+      dev = time_model(*find_model("han_" + method + "_vk"), sc, vk_frames, c.pool, c.opt.device) / passes;
     }
-    time[model][method] = {cpu.step_ms / passes, dev};
+    time[model][method] = {cpu / passes, dev};
   }
   auto measured = [&](const std::string& model, const std::string& method) {
     const auto& p = time[model][method];
