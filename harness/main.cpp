@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "harness/charts.h"
 #include "harness/progress.h"
+#include "harness/reproduce.h"
 #include "harness/runner.h"
 #include "harness/stress.h"
 #include "models/registry.h"
@@ -37,6 +38,8 @@ constexpr const char* kUsage = R"(usage:
                   [--out DIR] [--no-charts]
   hairbench stress [--models REGEX] [--base SCENARIO] [--axes REGEX] [--keep-every N]
                    [--quick] [--threads N] [--out DIR] [--no-charts]
+  hairbench reproduce han2012|halen2007|plante2001|all [--frames N] [--threads N]
+                      [--device NAME|INDEX] [--out DIR]
 
 compare runs every selected model in lockstep on each scenario (default: every built-in
 scenario) and writes DIR/report.json (default DIR: reports/out/latest), then its charts,
@@ -58,6 +61,11 @@ from the stable base scenario (default shake, every 10th strand) until each mode
 runs degenerate grooms, prints the table, writes DIR/stress.json (default DIR:
 reports/out/stress) and draws its heatmap DIR/stress_heatmap.png. --quick tries every other value
 of each axis.
+reproduce runs the configurations of the papers' published tables (reports/published/)
+and writes DIR/reproduce.json, .md and .html (default DIR: reports/out/reproduce): per
+row the published and measured values and a hardware-independent comparison, and the
+papers' claims as checks, each with a verdict (holds / differs). --frames N caps every
+run at N frames (quick runs).
 exit codes: 0 done (unstable models are results, not errors), 1 internal error or chart
 script failure, 2 bad arguments or files)";
 
@@ -414,6 +422,7 @@ int run(int argc, char** argv) {
   if (cmd == "sweep") return cmd_sweep(args);
   if (cmd == "list") return cmd_list(args);
   if (cmd == "stress") return cmd_stress(args);
+  if (cmd == "reproduce") return cmd_reproduce(args);
   throw InputError("arguments", cmd, "unknown command (see hairbench --help)");
 }
 

@@ -129,6 +129,9 @@ def load_json(path):
         raise GateError(f"{path}: not JSON: line {e.lineno}: {e.msg}") from None
 
 
+_NS_PER = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}
+
+
 def benchmark_samples(docs):
     """{benchmark name: [real_time, ...]} from one or more Google Benchmark JSON
     documents (the rounds of an interleaved run), in the order they appear."""
@@ -143,7 +146,12 @@ def benchmark_samples(docs):
             t = b.get("real_time")
             if not isinstance(name, str) or not isinstance(t, (int, float)):
                 raise GateError(f"{path}: benchmarks: entry without name or real_time")
-            samples.setdefault(name, []).append(float(t))
+            # Benchmarks report in their own unit (hairbench_bench's BM_step in ms): the
+            # summary table is in ns.
+            unit = b.get("time_unit", "ns")
+            if unit not in _NS_PER:
+                raise GateError(f"{path}: benchmarks: {name}: unknown time_unit '{unit}'")
+            samples.setdefault(name, []).append(float(t) * _NS_PER[unit])
     return samples
 
 

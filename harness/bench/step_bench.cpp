@@ -22,6 +22,12 @@
 // The roofline probes: BM_roofline_stream/bytes:N streams a buffer (read + write) on all
 // threads, in GB/s; BM_roofline_fma runs independent fused multiply-add chains on all
 // threads at the widest vector width the CPU has, in GFLOP/s.
+//
+// Test-only knob: HAIRBENCH_BENCH_PLANTED_SLOWDOWN=F (e.g. 0.3) steps a second instance of
+// the model, inside the timed region, on a fraction F of the frames: F times the step's
+// work, real and deterministic (the same instruction count every run), so that
+// tests/perf_gate_e2e.sh can check that ci/perf-gate catches a known slowdown (issue 9).
+// Unset or 0: no extra work.
 #include "core/parallel.h"
 #include "harness/roofline.h"
 #include "harness/runner.h"
@@ -33,6 +39,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -50,6 +57,11 @@ namespace {
 // Groom sizes: the scenario's own groom and every 4th strand of it (a procedural groom
 // is the same hair at a lower density). Asset grooms with follow hairs keep their own.
 constexpr std::size_t kThinning[] = {1, 4};
+
+double planted_slowdown() {
+  const char* v = std::getenv("HAIRBENCH_BENCH_PLANTED_SLOWDOWN");
+  return v ? std::max(0.0, std::atof(v)) : 0.0;
+}
 
 Scenario thinned(const Scenario& sc, std::size_t keep_every) {
   if (keep_every == 1) return sc;
@@ -80,12 +92,16 @@ void bm_step(benchmark::State& state, const ModelInfo* info, const Scenario* sc,
   double step_s = 0.0, min_s = 1e30, dev2 = 0.0, jag = 0.0;
   int f = 0;
   bool stable = true;
+  const double slowdown = planted_slowdown();
+  std::unique_ptr<HairModel> planted = slowdown > 0.0 ? make_model(*info, *sc, resolve_params(*info, *sc, {}), pool) : nullptr;
+  double planted_owed = 0.0;
   for (auto _ : state) {
     const FrameInput in = frame_input(*sc, f);
     if (ref) ref->step(in, times);
     times.clear();
     const auto start = std::chrono::steady_clock::now();
     model->step(in, times);
+    for (planted_owed += slowdown; planted && planted_owed >= 1.0; planted_owed -= 1.0) planted->step(in, times);
     const auto end = std::chrono::steady_clock::now();
     const double s = std::chrono::duration<double>(end - start).count();
     state.SetIterationTime(s);
