@@ -570,6 +570,8 @@ PlanteResult run_plante(const PlanteStyle& style, int frames) {
   const Scenario shake = load_scenario(find_scenario("shake"));
   ParamSet params(plante::kParams, groom.region_names.size());
   params.set("wisps", style.wisps, {"reproduce", ""});
+  // The paper's wisp counts as they are: no splitting of wide wisps (as BM_PlanteStyle).
+  params.set("wisp_width_max", 1000, {"reproduce", ""});
   ThreadPool pool(1);  // the paper's single R12000
   plante::PlanteWispModel model(ModelContext{&pool});
   model.reset(groom, params);
