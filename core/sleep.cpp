@@ -33,6 +33,14 @@ void StrandSleep::observe(std::size_t s, std::span<const Vec4f> pos, std::span<c
   }
 }
 
+void StrandSleep::observe_speed(std::size_t s, float speed) {
+  if (speed < kRestSpeed) {
+    if (++quiet_frames_[s] >= kQuietFrames) asleep_[s] = 1;
+  } else {
+    quiet_frames_[s] = 0;
+  }
+}
+
 std::size_t StrandSleep::asleep_count() const {
   return static_cast<std::size_t>(std::count(asleep_.begin(), asleep_.end(), std::uint8_t{1}));
 }

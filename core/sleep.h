@@ -28,6 +28,9 @@ class StrandSleep {
   // vertices' largest displacement over the last (sub)step of length dt. Touches only
   // strand s's entries, so strands may be observed in parallel.
   void observe(std::size_t s, std::span<const Vec4f> pos, std::span<const Vec4f> prev, float dt);
+  // The same, for models whose state is not positions: a bound on the strand's largest
+  // vertex speed, m/s.
+  void observe_speed(std::size_t s, float speed);
   std::size_t asleep_count() const;
   // Whether every strand slept through the last observed step; refreshed by
   // end_observe(), after the step's observe() calls. A model then skips the whole step.

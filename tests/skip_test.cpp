@@ -19,11 +19,16 @@
 namespace hairbench {
 namespace {
 
-// Every CPU model: the position-based ones skip passes and sleep; the forest and the
-// wisps only skip their body pass, and must come out identical all the same.
+// Every CPU model. The position-based ones skip passes; the forest and the wisps only
+// skip their body pass, and must come out identical all the same. All of them sleep
+// (plante_wisp as a whole: its wisps touch each other).
 const std::vector<std::string> kCpuModels = {"han_m1",       "han_m2",        "han_m3",     "halen_spring",
                                              "halen_cascade", "halen_forest", "plante_wisp"};
-const std::vector<std::string> kSleepers = {"han_m1", "han_m2", "han_m3", "halen_spring", "halen_cascade"};
+// plante_wisp can sleep too, but never comes to rest on `idle`: after 10 s its fastest
+// skeleton mass still moves at 0.42 m/s and a quarter of its envelope masses faster than
+// 1 mm/s, a limit cycle of the explicit 1000 Hz integration (issue 5, open).
+const std::vector<std::string> kSleepers = {"han_m1",       "han_m2",        "han_m3",
+                                            "halen_spring", "halen_cascade", "halen_forest"};
 
 struct Simulation {
   std::vector<Vec4f> positions;

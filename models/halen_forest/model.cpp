@@ -2,6 +2,8 @@
 
 #include "core/parallel.h"
 
+#include <cmath>
+
 namespace hairbench::halen_forest {
 
 namespace k = hairbench::kernels;
@@ -48,6 +50,7 @@ void ForestModel::reset(const Groom& rest, const ParamSet& params) {
   joint_torque_.assign(nv, Vec3f::Zero());
   pos_ = rest.positions;
   head_hist_[0] = head_hist_[1] = Affine3f::Identity();
+  sleep_.reset(rest.strand_count());
   pose(Affine3f::Identity());
 }
 
@@ -68,10 +71,12 @@ k::ForestStrand ForestModel::strand_view(std::size_t s) {
           std::span(pos_).subspan(b, n)};
 }
 
+// Visits every awake strand; a sleeping strand is not touched (issue 8).
 template <class F>
 void ForestModel::for_each_strand(F&& f) {
   ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) f(s);
+    for (std::size_t s = begin; s < end; ++s)
+      if (!sleep_.asleep(s)) f(s);
   });
 }
 
@@ -81,6 +86,13 @@ void ForestModel::pose(const Affine3f& head) {
 
 void ForestModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    // Every strand sleeps: not even the per-strand checks run (issue 8). The head has
+    // been still for kQuietFrames frames, so head_hist_ already holds it.
+    for (std::string_view stage : {"pose", "integrate"}) times.skip(stage);
+    return;
+  }
   for (int i = 1; i <= substeps_; ++i) {
     const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(substeps_));
     {
@@ -114,8 +126,22 @@ void ForestModel::step(const FrameInput& in, StageTimes& times) {
       k::forest_integrate(strand_view(s), axes_, fs);
     });
   }
-  StageTimer t(times, "pose");
-  pose(in.head);
+  {
+    StageTimer t(times, "pose");
+    pose(in.head);
+  }
+  if (calm) {
+    StageTimer t(times, "sleep");
+    // A bound on the fastest vertex: every joint's angular speed acting over the whole
+    // strand length (Eq. 4.2.6's angles are the state; positions follow from them).
+    for_each_strand([&](std::size_t s) {
+      const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+      float omega = 0.0f;
+      for (std::size_t i = b; i < b + n; ++i) omega += std::abs(dtheta_[i]) + std::abs(dphi_[i]);
+      sleep_.observe_speed(s, omega / inv_strand_length_[s]);
+    });
+    sleep_.end_observe();
+  }
 }
 
 std::unique_ptr<HairModel> make(const ModelContext& ctx) { return std::make_unique<ForestModel>(ctx); }

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/sleep.h"
 #include "kernels/cpu/halen_kernels.h"
 
 #include <memory>
@@ -43,6 +44,7 @@ class ForestModel final : public HairModel {
   Affine3f head_hist_[2];  // head transforms of the last two substeps (the root's inertia)
   std::vector<Vec4f> pos_;
   std::vector<Vec4f> spheres_;
+  StrandSleep sleep_;
 };
 
 std::unique_ptr<HairModel> make(const ModelContext& ctx);

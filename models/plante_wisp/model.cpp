@@ -182,6 +182,7 @@ void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp
 
 void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   rest_ = rest;
+  sleep_.reset(1);
   params_.clear();
   for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
     k::WispParams p;
@@ -260,6 +261,11 @@ void PlanteWispModel::detect_self_interactions() {
 // (3) velocities then their modifications, (4) positions then their modifications;
 // skeleton before envelope, root to tip (inside the kernels).
 void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    for (std::string_view stage : {"integration", "body_collision", "self_interaction", "rebuild"}) times.skip(stage);
+    return;
+  }
   // Issue 8: without colliders there is no body pass at all, and the report says so;
   // --no-skip runs the pass over no spheres.
   const bool body_pass = !in.colliders.empty() || !ctx_.skip_inert;
@@ -325,8 +331,18 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     }
     head_before = head;
   }
-  StageTimer t(times, "rebuild");
-  rebuild(in.head);
+  {
+    StageTimer t(times, "rebuild");
+    rebuild(in.head);
+  }
+  if (calm) {
+    // The fastest skeleton mass or envelope mass (along its half-line) decides.
+    float speed2 = 0.0f;
+    for (const Vec3f& v : sys_.v) speed2 = std::max(speed2, v.squaredNorm());
+    for (float rd : sys_.rdot) speed2 = std::max(speed2, rd * rd);
+    sleep_.observe_speed(0, std::sqrt(speed2));
+    sleep_.end_observe();
+  }
 }
 
 // §5.2: the strands are drawn at fixed positions relative to the wisp envelope: the

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/sleep.h"
 #include "kernels/cpu/wisp_grid.h"
 #include "kernels/cpu/wisp_kernels.h"
 
@@ -48,6 +49,9 @@ class PlanteWispModel final : public HairModel {
   kernels::InteractionParams interaction_;
   double integration_hz_ = 1000, collision_hz_ = 120, interaction_hz_ = 24;
   int threads_min_wisps_ = 64;
+  // Wisps touch each other, so the hair sleeps as a whole: one "strand" in StrandSleep
+  // that stands for every wisp (issue 8).
+  StrandSleep sleep_;
 
   kernels::WispSystem sys_;
   std::vector<std::uint32_t> strand_wisp_;
