@@ -199,6 +199,11 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
       why = "the Vulkan device is a CPU (" + vk::Context::get(a.run.device)->device().name +
             "); name it in --models to run it";
 #endif
+    // The _ref variants are today's straightforward implementations kept for issue 10's
+    // side-by-side speed-ups; their results are bit-identical to the fast models'.
+    if (why.empty() && !a.models_given && std::string_view(m.name).ends_with("_ref"))
+      why = "bit-identical reference implementation of " + std::string(m.name.substr(0, m.name.size() - 4)) +
+            "; name it in --models to run it";
     if (why.empty()) a.run.models.emplace_back(m.name);
     else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
     else a.skipped.push_back(std::string(m.name) + ": " + why);
