@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "harness/charts.h"
 #include "harness/progress.h"
+#include "harness/args.h"
 #include "harness/reproduce.h"
 #include "harness/runner.h"
 #include "harness/stress.h"
@@ -85,20 +86,6 @@ struct CompareArgs {
   bool charts = true;
   std::optional<KnobSpec> knob;  // sweep only
 };
-
-int parse_int(const std::string& flag, const std::string& v, int lo, int hi) {
-  std::size_t used = 0;
-  long long x = 0;
-  try {
-    x = std::stoll(v, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != v.size() || x < lo || x > hi)
-    throw InputError("arguments", flag, "'" + v + "' is not a whole number in [" + std::to_string(lo) + ", " +
-                                            std::to_string(hi) + "]");
-  return static_cast<int>(x);
-}
 
 // --knob NAME=V1,V2,...: a parameter name and distinct finite numbers.
 KnobSpec parse_knob(const std::string& arg) {

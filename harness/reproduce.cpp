@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "harness/args.h"
 #include "harness/runner.h"
 #include "harness/stress.h"
 #include "models/plante_wisp/model.h"
@@ -567,7 +568,8 @@ PlanteResult run_plante(const PlanteStyle& style, int frames) {
   spec.vertices_per_strand = style.vertices;
   spec.length = style.length;
   const Groom groom = generate_groom(spec, 0.1f, "reproduce").groom;
-  const Scenario shake = load_scenario(find_scenario("shake"));
+  Scenario shake = load_scenario(find_scenario("shake"));
+  shake.dt = kFrameDt;  // the head script of `shake`, sampled at the paper's 24 frames/s
   ParamSet params(plante::kParams, groom.region_names.size());
   params.set("wisps", style.wisps, {"reproduce", ""});
   // The paper's wisp counts as they are: no splitting of wide wisps (as BM_PlanteStyle).
@@ -579,14 +581,7 @@ PlanteResult run_plante(const PlanteStyle& style, int frames) {
   std::map<std::string, double> stage;
   double total = 0.0;
   for (int f = 0; f < frames; ++f) {
-    FrameInput in;
-    in.frame = f;
-    in.dt = kFrameDt;
-    in.t = (f + 1) * kFrameDt;
-    in.head_prev = shake.head.at(f * kFrameDt);
-    in.head = shake.head.at(in.t);
-    in.gravity = shake.gravity;
-    in.colliders = shake.colliders;
+    const FrameInput in = frame_input(shake, f);
     times.clear();
     const auto start = std::chrono::steady_clock::now();
     model.step(in, times);
@@ -773,19 +768,6 @@ json check_json(const ReproduceCheck& c) {
 
 ReproduceOptions parse_reproduce_args(const std::vector<std::string>& args) {
   ReproduceOptions o;
-  auto whole = [](const std::string& flag, const std::string& v, int lo, int hi) {
-    std::size_t used = 0;
-    long long x = 0;
-    try {
-      x = std::stoll(v, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != v.size() || x < lo || x > hi)
-      throw InputError("arguments", flag, "'" + v + "' is not a whole number in [" + std::to_string(lo) + ", " +
-                                              std::to_string(hi) + "]");
-    return static_cast<int>(x);
-  };
   std::vector<std::string> which;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -793,8 +775,8 @@ ReproduceOptions parse_reproduce_args(const std::vector<std::string>& args) {
       if (i + 1 >= args.size()) throw InputError("arguments", a, "needs a value");
       return args[++i];
     };
-    if (a == "--frames") o.frames = whole(a, value(), 1, 1'000'000);
-    else if (a == "--threads") o.threads = whole(a, value(), 1, 1024);
+    if (a == "--frames") o.frames = parse_int(a, value(), 1, 1'000'000);
+    else if (a == "--threads") o.threads = parse_int(a, value(), 1, 1024);
     else if (a == "--device") o.device = value();
     else if (a == "--out") o.out = value();
     else if (!a.empty() && a[0] == '-') throw InputError("arguments", a, "unknown option (see hairbench --help)");

@@ -1,5 +1,7 @@
 // The command line's contract: bad files and bad arguments give exit code 2 and one
 // line naming what is wrong; good runs write a report that follows the schema.
+#include "cli_support.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -10,26 +12,10 @@
 #include <map>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;
-};
-
-Result run_cli(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + "\"" + HAIRBENCH_EXE + "\" " + args + " 2>&1";
-  Result r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) r.out += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using hairbench::test::run_cli;
 
 int count_lines(const std::string& s) {
   int n = 0;
@@ -50,7 +36,7 @@ TEST(Cli, BadScenarioFilesAreOneLineErrors) {
     std::string file, expected;
     is >> file;
     std::getline(is >> std::ws, expected);
-    const Result r = run_cli("compare --frames 1 --scenario \"" + (dir / file).string() + "\" --out /tmp/hairbench-cli-test");
+    const hairbench::test::CliResult r = run_cli("compare --frames 1 --scenario \"" + (dir / file).string() + "\" --out /tmp/hairbench-cli-test");
     EXPECT_EQ(r.code, 2) << file << ": " << r.out;
     EXPECT_EQ(count_lines(r.out), 1) << file << ": " << r.out;
     EXPECT_NE(r.out.find(file), std::string::npos) << "message does not name the file: " << r.out;
@@ -66,17 +52,17 @@ TEST(Cli, BadArgumentsExitTwo) {
                            "compare --models 'nothing_matches'", "compare --models '('", "compare --bogus",
                            "compare --scenario no_such_scenario", "list things", "frobnicate",
                            "compare --set han_m1.local_iterations=2.5", "compare --reference nosuch"}) {
-    const Result r = run_cli(args);
+    const hairbench::test::CliResult r = run_cli(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.out;
     EXPECT_EQ(count_lines(r.out), 1) << args << ": " << r.out;
   }
 }
 
 TEST(Cli, ListsModelsAndScenarios) {
-  const Result models = run_cli("list models");
+  const hairbench::test::CliResult models = run_cli("list models");
   EXPECT_EQ(models.code, 0);
   for (const char* m : {"han_m1", "han_m2", "han_m3"}) EXPECT_NE(models.out.find(m), std::string::npos) << m;
-  const Result scenarios = run_cli("list scenarios");
+  const hairbench::test::CliResult scenarios = run_cli("list scenarios");
   EXPECT_EQ(scenarios.code, 0);
   for (const char* s : {"idle", "nod", "shake", "spin_fast", "walk", "tilt_upside_down", "wind_gust", "ponytail"})
     EXPECT_NE(scenarios.out.find(s), std::string::npos) << s;
@@ -88,7 +74,7 @@ TEST(Cli, CompareWritesTheReportContract) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-compare";
   std::filesystem::remove_all(out);
   // Han's three methods: the stage names below are theirs (other models name their own).
-  const Result r = run_cli("compare --scenario shake --models 'han_m[123]' --frames 5 --threads 2 "
+  const hairbench::test::CliResult r = run_cli("compare --scenario shake --models 'han_m[123]' --frames 5 --threads 2 "
                            "--set han_m2.local_iterations=7 --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in(out / "report.json");
@@ -136,7 +122,7 @@ TEST(Cli, SweepBadArgumentsExitTwo) {
         "sweep" + sc + " --knob local_iterations=1 --knob substeps=2",
         "sweep" + sc + " --knob local_iterations=1 --reference bogus",
         "compare" + sc + " --knob local_iterations=1"}) {
-    const Result r = run_cli(args);
+    const hairbench::test::CliResult r = run_cli(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.out;
     EXPECT_EQ(count_lines(r.out), 1) << args << ": " << r.out;
   }
@@ -166,7 +152,7 @@ double snapshot_deviation(const nlohmann::json& strands, const nlohmann::json& r
 TEST(Cli, SweepRecordsKnobsPhasesAndSnapshots) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-sweep";
   std::filesystem::remove_all(out);
-  const Result r = run_cli("sweep --scenario \"" + kTinyShake +
+  const hairbench::test::CliResult r = run_cli("sweep --scenario \"" + kTinyShake +
                            "\" --models 'han_m[12]' --knob local_iterations=1,3 --frames 30 --threads 2 --no-charts --out " +
                            out.string());
   ASSERT_EQ(r.code, 0) << r.out;
@@ -216,7 +202,7 @@ TEST(Cli, SweepRecordsKnobsPhasesAndSnapshots) {
 TEST(Cli, ConvergedReferenceMeasuresMethodOneToo) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-converged";
   std::filesystem::remove_all(out);
-  const Result r = run_cli("sweep --scenario \"" + kTinyShake +
+  const hairbench::test::CliResult r = run_cli("sweep --scenario \"" + kTinyShake +
                            "\" --models han_m1 --knob local_iterations=1 --reference converged --frames 20 --no-charts --out " +
                            out.string());
   ASSERT_EQ(r.code, 0) << r.out;
@@ -234,7 +220,7 @@ TEST(Cli, ConvergedReferenceMeasuresMethodOneToo) {
 TEST(Cli, ChartStepSaysHowToDrawLater) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-nocharts";
   std::filesystem::remove_all(out);
-  const Result r = run_cli("compare --scenario \"" + kTinyShake + "\" --models han_m3 --frames 3 --out " + out.string(),
+  const hairbench::test::CliResult r = run_cli("compare --scenario \"" + kTinyShake + "\" --models han_m3 --frames 3 --out " + out.string(),
                            "HAIRBENCH_PYTHON=/nonexistent/python3 ");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_TRUE(std::filesystem::exists(out / "report.json"));

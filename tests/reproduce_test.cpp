@@ -3,6 +3,8 @@
 // follows from the measured value and the stated bounds.
 #include "harness/reproduce.h"
 
+#include "cli_support.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -14,26 +16,10 @@
 #include <limits>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;
-};
-
-Result run_cli(const std::string& args) {
-  const std::string cmd = "\"" + std::string(HAIRBENCH_EXE) + "\" " + args + " 2>&1";
-  Result r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) r.out += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using hairbench::test::run_cli;
 
 std::string slurp(const std::filesystem::path& f) {
   std::ifstream in(f);
@@ -60,7 +46,7 @@ void expect_verdict_follows(const nlohmann::json& c) {
 TEST(Reproduce, BadArgumentsExitTwo) {
   for (const char* args : {"reproduce", "reproduce nosuch", "reproduce han2012 --frames 0", "reproduce all --bogus",
                            "reproduce plante2001 --frames", "reproduce halen2007 --threads x"}) {
-    const Result r = run_cli(args);
+    const hairbench::test::CliResult r = run_cli(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << ": " << r.out;
   }
@@ -88,7 +74,7 @@ TEST(Reproduce, VerdictFollowsTheBounds) {
 TEST(Reproduce, QuickPlanteRunWritesTheReport) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-reproduce-test";
   std::filesystem::remove_all(out);
-  const Result r = run_cli("reproduce plante2001 --frames 2 --threads 1 --out \"" + out.string() + "\"");
+  const hairbench::test::CliResult r = run_cli("reproduce plante2001 --frames 2 --threads 1 --out \"" + out.string() + "\"");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("## Verdicts"), std::string::npos) << r.out;
 

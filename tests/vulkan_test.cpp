@@ -3,6 +3,7 @@
 // models, strands that do not fill a workgroup or overflow one, and the one-line errors
 // when there is no device. The remaining method x scenario agreements and the stability
 // sweep are in vulkan_agreement_test.cpp (label slow).
+#include "cli_support.h"
 #include "kernels/vulkan/runtime.h"
 #include "vulkan_support.h"
 
@@ -10,7 +11,6 @@
 #include <cstdio>
 #include <fstream>
 #include <numbers>
-#include <sys/wait.h>
 
 namespace hairbench {
 namespace {
@@ -117,48 +117,24 @@ TEST(VulkanModels, RefusesAStrandBeyondSharedMemory) {
   }
 }
 
-struct Cli {
-  int code;
-  std::string out;
-};
-
-Cli run_cli(const std::string& args) {
-  const std::string cmd = std::string("\"") + HAIRBENCH_EXE + "\" " + args + " 2>&1";
-  Cli r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) r.out += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::run_cli;
 
 // Without any Vulkan driver (the loader pointed at a missing ICD): one clear line, and
 // the CPU models still run. Needs no device, so it never skips.
 TEST(VulkanCli, NoDeviceIsOneClearLine) {
   const std::string env = "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json ";
-  const std::string cmd = std::string("env ") + env + "\"" + HAIRBENCH_EXE + "\" ";
-  auto run = [&](const std::string& args) {
-    Cli r{-1, {}};
-    FILE* p = popen((cmd + args + " 2>&1").c_str(), "r");
-    char buf[4096];
-    while (p && std::fgets(buf, sizeof buf, p)) r.out += buf;
-    const int status = p ? pclose(p) : -1;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-  };
-  const Cli asked = run("compare --scenario idle --frames 1 --models han_m1_vk --out /tmp/hairbench-vk-test");
+  auto run = [&](const std::string& args) { return run_cli(args, "env " + env); };
+  const test::CliResult asked = run("compare --scenario idle --frames 1 --models han_m1_vk --out /tmp/hairbench-vk-test");
   EXPECT_EQ(asked.code, 2) << asked.out;
   EXPECT_EQ(std::count(asked.out.begin(), asked.out.end(), '\n'), 1) << asked.out;
   EXPECT_NE(asked.out.find("han_m1_vk cannot run: Vulkan: no driver"), std::string::npos) << asked.out;
 
-  const Cli all = run("compare --scenario idle --frames 1 --out /tmp/hairbench-vk-test");
+  const test::CliResult all = run("compare --scenario idle --frames 1 --out /tmp/hairbench-vk-test");
   EXPECT_EQ(all.code, 0) << all.out;
   EXPECT_NE(all.out.find("skipped model han_m2_vk: Vulkan: no driver"), std::string::npos) << all.out;
   EXPECT_NE(all.out.find("han_m3 "), std::string::npos) << "the CPU models still run: " << all.out;
 
-  const Cli list = run("list devices");
+  const test::CliResult list = run("list devices");
   EXPECT_EQ(list.code, 0) << list.out;
   EXPECT_NE(list.out.find("Vulkan: no driver"), std::string::npos) << list.out;
 }
@@ -166,7 +142,7 @@ TEST(VulkanCli, NoDeviceIsOneClearLine) {
 // --device that matches nothing is a bad argument (exit 2) naming the devices there are.
 TEST(VulkanCli, UnknownDeviceIsABadArgument) {
   HAIRBENCH_REQUIRE_VULKAN();
-  const Cli r = run_cli("compare --scenario idle --frames 1 --models han_m1_vk --device no-such-gpu --out /tmp/hairbench-vk-test");
+  const test::CliResult r = run_cli("compare --scenario idle --frames 1 --models han_m1_vk --device no-such-gpu --out /tmp/hairbench-vk-test");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--device: no-such-gpu: no Vulkan device"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("have: 0 '"), std::string::npos) << r.out;
@@ -176,7 +152,7 @@ TEST(VulkanCli, UnknownDeviceIsABadArgument) {
 // context.devices) for the Vulkan models, and nothing new for the CPU ones.
 TEST(VulkanCli, ReportHasGpuTime) {
   HAIRBENCH_REQUIRE_VULKAN();
-  const Cli r = run_cli("compare --scenario idle --frames 3 --models 'han_m3(_vk)?' --device 0 --out /tmp/hairbench-vk-report");
+  const test::CliResult r = run_cli("compare --scenario idle --frames 3 --models 'han_m3(_vk)?' --device 0 --out /tmp/hairbench-vk-report");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in("/tmp/hairbench-vk-report/report.json");
   const nlohmann::json j = nlohmann::json::parse(in);
