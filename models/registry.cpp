@@ -7,6 +7,7 @@
 #include "models/halen_cascade/settings.h"
 #include "models/halen_forest/model.h"
 #include "models/halen_forest/settings.h"
+#include "models/halen_fused/model.h"
 #include "models/halen_spring/model.h"
 #include "models/halen_spring/settings.h"
 #include "models/plante_wisp/model.h"
@@ -33,12 +34,16 @@ std::span<const ModelInfo> model_registry() {
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::Jacobi, c); }},
       {"han_m3_ref", "han_m3 as one stage at a time over all strands (per-strand kernels; the reference for han_m3)",
        han::kParams, [](const ModelContext& c) { return han::make_han(han::Method::RestFrames, c); }},
-      {"halen_spring", "Halén & Wester 2007 §4.4: springs to head-fixed reference nodes, tilt-weakened (§5.9)",
-       halen_spring::kParams, [](const ModelContext& c) { return halen_spring::make(c); }},
-      {"halen_cascade", "Halén & Wester 2007 §4.3: cascading tangent spaces with up/down reference nodes (§5.9)",
-       halen_cascade::kParams, [](const ModelContext& c) { return halen_cascade::make(c); }},
+      {"halen_spring", "Halén & Wester 2007 §4.4: springs to head-fixed reference nodes, tilt-weakened (§5.9); fused SoA kernel",
+       halen_spring::kParams, [](const ModelContext& c) { return halen_fused::make(halen_fused::Model::Spring, c); }},
+      {"halen_cascade", "Halén & Wester 2007 §4.3: cascading tangent spaces with up/down reference nodes (§5.9); fused SoA kernel",
+       halen_cascade::kParams, [](const ModelContext& c) { return halen_fused::make(halen_fused::Model::Cascade, c); }},
       {"halen_forest", "Halén & Wester 2007 §4.2 (Di Giacomo et al. 2001): joint angles, x-primary axes (§5.9)",
        halen_forest::kParams, [](const ModelContext& c) { return halen_forest::make(c); }},
+      {"halen_spring_ref", "halen_spring as one stage at a time over all strands (per-strand kernels; the reference for halen_spring)",
+       halen_spring::kParams, [](const ModelContext& c) { return halen_spring::make(c); }},
+      {"halen_cascade_ref", "halen_cascade as one stage at a time over all strands (per-strand kernels; the reference for halen_cascade)",
+       halen_cascade::kParams, [](const ModelContext& c) { return halen_cascade::make(c); }},
       {"plante_wisp", "Plante, Cani & Poulin 2001: layered wisps (skeleton, envelope, strands) with anisotropic interactions (§3-5)",
        plante::kParams, [](const ModelContext& c) { return plante::make_plante_wisp(c); }},
 #ifdef HAIRBENCH_HAS_VULKAN

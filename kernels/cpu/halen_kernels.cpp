@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace hairbench::kernels {
 
@@ -37,6 +38,51 @@ void add_spring_acceleration(std::span<Vec4f> pos, std::span<const Vec4f> prev, 
   for (std::size_t i = 0; i < pos.size(); ++i) {
     if (pos[i].w() == 0.0f) continue;
     pos[i].head<3>() += (scale * k[i] * dt2) * (ref[i] - xyz(prev[i]));
+  }
+}
+
+void spring_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, std::span<float> k,
+                  std::span<float> lift) {
+  std::vector<float> arc(rest.size());
+  arc_lengths(rest, arc);
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    k[i] = falloff_stiffness(stiffness, arc[i], c, exponent);
+    // §4.4: the reference node is the rest node, fixed relative to the head, "displaced
+    // vertically ... to compensate for gravity" by L = mg/k (g/k_L per unit mass). The
+    // displacement is along world up, so the head-transformed rest shape is in
+    // equilibrium in any head pose while k_m = k, which is what the tilt weakening relaxes.
+    lift[i] = k[i] > 0.0f ? 1.0f / k[i] : 0.0f;
+  }
+}
+
+void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, float down_fraction,
+                   std::span<float> k_up, std::span<float> k_down, std::span<Mat3f> rest_space,
+                   std::span<Vec3f> up_local, std::span<Vec3f> down_local, std::span<float> lift) {
+  const std::size_t n = rest.size();
+  std::vector<float> arc(n);
+  arc_lengths(rest, arc);
+  for (std::size_t i = 0; i < n; ++i) {
+    k_up[i] = k_down[i] = lift[i] = 0.0f;
+    up_local[i] = down_local[i] = Vec3f::Zero();
+  }
+  for (std::size_t i = 2; i < n; ++i) {
+    k_up[i] = falloff_stiffness(stiffness, arc[i], c, exponent);
+    // Only nodes with a segment two below them have a downward reference node.
+    if (i + 2 < n) k_down[i] = down_fraction * k_up[i];
+  }
+  const Vec3f root_dir = (xyz(rest[1]) - xyz(rest[0])).normalized();
+  tangent_spaces(rest, root_tangent_space(root_dir), rest_space);
+  // §4.3: the reference nodes are the rest positions of the nodes in the tangent spaces
+  // of the rest shape, displaced upward so that their springs carry the node's weight:
+  // L = mg/k, and with an upward and a downward node both by mg/(k_up + k_down) ("half
+  // the distance" when the two are equally strong). The displacement is along world up,
+  // so the head-transformed rest shape is in equilibrium in any head pose.
+  auto p = [&](std::size_t i) -> Vec3f { return xyz(rest[i]); };
+  for (std::size_t i = 2; i < n; ++i) {
+    const float ksum = k_up[i] + k_down[i];
+    lift[i] = ksum > 0.0f ? 1.0f / ksum : 0.0f;
+    up_local[i] = rest_space[i - 1].transpose() * (p(i) - p(i - 1));
+    if (i + 2 < n) down_local[i] = rest_space[i + 2].transpose() * (p(i) - p(i + 2));
   }
 }
 

@@ -41,6 +41,21 @@ void head_references(std::span<const Vec3f> local, std::span<const float> lift, 
 void add_spring_acceleration(std::span<Vec4f> pos, std::span<const Vec4f> prev, std::span<const Vec3f> ref,
                              std::span<const float> k, float scale, float dt);
 
+// ---- set-up of the spring models, shared by the reference and the fused models --------
+
+// §4.4 with §5.9's falloff, one strand: the spring strength k_L of every vertex and its
+// reference node's lift 1/k_L (L = mg/k per unit mass; 0 where k_L is 0).
+void spring_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, std::span<float> k,
+                  std::span<float> lift);
+
+// §4.3 with §5.9's falloff and downward fraction, one strand: the upward (vertices 2..n)
+// and downward (vertices with a segment two below them) spring strengths, the rest
+// tangent spaces, the reference nodes in them and the lift 1/(k_up + k_down) they share.
+// Entries a vertex has no use for are 0.
+void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, float down_fraction,
+                   std::span<float> k_up, std::span<float> k_down, std::span<Mat3f> rest_space,
+                   std::span<Vec3f> up_local, std::span<Vec3f> down_local, std::span<float> lift);
+
 // ---- cascading spaces (§4.3) ----------------------------------------------------------
 
 // A tangent space as the matrix M = [B N T] (columns): N along the segment, B and T

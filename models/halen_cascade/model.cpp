@@ -21,45 +21,22 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   sleep_.reset(rest.strand_count());
 
   const std::size_t nv = rest.vertex_count();
-  std::vector<float> arc(nv);
-  k_up_.assign(nv, 0.0f);
-  k_down_.assign(nv, 0.0f);
-  rest_space_.assign(nv, k::Mat3f::Identity());
+  k_up_.resize(nv);
+  k_down_.resize(nv);
+  rest_space_.resize(nv);
+  up_local_.resize(nv);
+  down_local_.resize(nv);
+  lift_.resize(nv);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
     const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
-    const auto strand_rest = std::span(rest.positions).subspan(b, n);
-    k::arc_lengths(strand_rest, std::span(arc).subspan(b, n));
-    const float stiffness = static_cast<float>(params.get("stiffness", r));
-    const float c = static_cast<float>(params.get("falloff_scale", r));
-    const int a = params.get_int("falloff_exponent", r);
-    const float down = static_cast<float>(params.get("down_fraction", r));
-    for (std::size_t i = 2; i < n; ++i) {
-      k_up_[b + i] = k::falloff_stiffness(stiffness, arc[b + i], c, a);
-      // Only nodes with a segment two below them have a downward reference node.
-      if (i + 2 < n) k_down_[b + i] = down * k_up_[b + i];
-    }
-    const Vec3f root_dir = (strand_rest[1].head<3>() - strand_rest[0].head<3>()).normalized();
-    k::tangent_spaces(strand_rest, k::root_tangent_space(root_dir), std::span(rest_space_).subspan(b, n));
+    k::cascade_setup(std::span(rest.positions).subspan(b, n), static_cast<float>(params.get("stiffness", r)),
+                     static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
+                     static_cast<float>(params.get("down_fraction", r)), std::span(k_up_).subspan(b, n),
+                     std::span(k_down_).subspan(b, n), std::span(rest_space_).subspan(b, n),
+                     std::span(up_local_).subspan(b, n), std::span(down_local_).subspan(b, n),
+                     std::span(lift_).subspan(b, n));
   }
   space_ = rest_space_;
-  // §4.3: the reference nodes are the rest positions of the nodes in the tangent spaces
-  // of the rest shape, displaced upward so that their springs carry the node's weight:
-  // L = mg/k, and with an upward and a downward node both by mg/(k_up + k_down) ("half
-  // the distance" when the two are equally strong). The displacement is along world up,
-  // so the head-transformed rest shape is in equilibrium in any head pose.
-  up_local_.assign(nv, Vec3f::Zero());
-  down_local_.assign(nv, Vec3f::Zero());
-  lift_.assign(nv, 0.0f);
-  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
-    auto p = [&](std::size_t i) -> Vec3f { return rest.positions[b + i].head<3>(); };
-    for (std::size_t i = 2; i < n; ++i) {
-      const float ksum = k_up_[b + i] + k_down_[b + i];
-      lift_[b + i] = ksum > 0.0f ? 1.0f / ksum : 0.0f;
-      up_local_[b + i] = rest_space_[b + i - 1].transpose() * (p(i) - p(i - 1));
-      if (i + 2 < n) down_local_[b + i] = rest_space_[b + i + 2].transpose() * (p(i) - p(i + 2));
-    }
-  }
   up_ref_.assign(nv, Vec3f::Zero());
   down_ref_.assign(nv, Vec3f::Zero());
 }

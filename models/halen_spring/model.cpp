@@ -22,26 +22,16 @@ void SpringModel::reset(const Groom& rest, const ParamSet& params) {
   substeps_ = params.get_int("substeps");
   sleep_.reset(rest.strand_count());
 
-  std::vector<float> arc(rest.vertex_count());
   k_.resize(rest.vertex_count());
+  lift_.resize(rest.vertex_count());
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
     const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
-    k::arc_lengths(std::span(rest.positions).subspan(b, n), std::span(arc).subspan(b, n));
-    const float stiffness = static_cast<float>(params.get("stiffness", r));
-    const float c = static_cast<float>(params.get("falloff_scale", r));
-    const int a = params.get_int("falloff_exponent", r);
-    for (std::size_t i = b; i < b + n; ++i) k_[i] = k::falloff_stiffness(stiffness, arc[i], c, a);
+    k::spring_setup(std::span(rest.positions).subspan(b, n), static_cast<float>(params.get("stiffness", r)),
+                    static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
+                    std::span(k_).subspan(b, n), std::span(lift_).subspan(b, n));
   }
-  // §4.4: the reference node is the rest node, fixed relative to the head, "displaced
-  // vertically ... to compensate for gravity" by L = mg/k (g/k_L per unit mass). The
-  // displacement is along world up, so the head-transformed rest shape is in
-  // equilibrium in any head pose while k_m = k, which is what the tilt weakening relaxes.
   ref_local_.resize(rest.vertex_count());
-  lift_.resize(rest.vertex_count());
-  for (std::size_t i = 0; i < rest.vertex_count(); ++i) {
-    ref_local_[i] = rest.positions[i].head<3>();
-    lift_[i] = k_[i] > 0.0f ? 1.0f / k_[i] : 0.0f;
-  }
+  for (std::size_t i = 0; i < rest.vertex_count(); ++i) ref_local_[i] = rest.positions[i].head<3>();
   ref_.assign(rest.vertex_count(), Vec3f::Zero());
 }
 

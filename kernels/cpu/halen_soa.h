@@ -1,0 +1,101 @@
+// Halén & Wester 2007's spring (§4.4) and cascading spaces (§4.3) models as one fused
+// pass per block of strands, structure of arrays: a block holds kLanes strands of one
+// region and one vertex count, field by field and vertex by vertex ([field][vertex][lane]),
+// so one vector instruction advances kLanes strands. The pass gathers a block's positions
+// from the groom-ordered float4 arrays, keeps it in L1 through every substep's stages
+// (references, integration, edge corrections, collisions) and writes the awake strands
+// back: a sleeping strand (core/sleep.h) is computed in its lane but never written.
+//
+// Every lane performs the same floating-point operations in the same order as the
+// per-strand kernels of strand_kernels.cpp and halen_kernels.cpp, with Eigen's evaluation
+// order written out (baseline build): affine · v = t + ((m00 v0 + m01 v1) + m02 v2),
+// Matrix3f · v and Matrix3f · Matrix3f = a0 b0 + (a1 b1 + a2 b2) per coefficient, dot
+// products and squared norms x + (y + z). FMA contraction is off (top CMakeLists.txt), so
+// the states are bit-identical to halen_spring_ref / halen_cascade_ref on any ISA variant
+// and for any thread count.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace hairbench::kernels::halen_soa {
+
+inline constexpr int kLanes = 16;
+
+enum class Model : int { Spring, Cascade };
+
+// Read-only fields of a block, each n rows of kLanes floats.
+enum Field : int {
+  RX, RY, RZ,  // rest positions in the head's rest frame (the spring model's reference nodes)
+  IW,          // inverse mass (0 = pinned)
+  RL,          // rest length of edge (i-1, i), 0 at the root
+  LIFT,        // upward displacement of the reference nodes per unit gravity (L = mg/k)
+  KU,          // spring model: k_L; cascade: the upward springs' k
+  kSpringFields,
+  KD = kSpringFields,  // cascade: the downward springs' k
+  UX, UY, UZ,          // cascade: upward reference nodes in their tangent spaces
+  DX, DY, DZ,          // cascade: downward reference nodes in their tangent spaces
+  kCascadeFields
+};
+// The cascade keeps the rest tangent space of the root segment ([B N T], 9 rows, column
+// by column) after its fields.
+inline constexpr int kRootSpaceRows = 9;
+inline constexpr std::size_t block_floats(Model m, int n) {
+  return m == Model::Spring ? static_cast<std::size_t>(kSpringFields * n) * kLanes
+                            : static_cast<std::size_t>(kCascadeFields * n + kRootSpaceRows) * kLanes;
+}
+// Per-thread scratch for a block of n vertices: positions, previous positions and the
+// world-space reference nodes (one set for the spring model, up and down for the cascade).
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(12 * n) * kLanes; }
+
+// What a row (one vertex of every lane) holds: most rows are all free or all pinned.
+enum RowKind : std::uint8_t { kRowFree, kRowPinned, kRowMixed };
+
+struct Block {
+  const float* data;              // block_floats(model, n) floats
+  int n;                          // vertices per strand
+  const std::uint32_t* offset;    // per lane: the strand's first vertex in the float4 arrays
+  const RowKind* rows;            // n entries
+  const std::uint8_t* write;      // per lane: 1 = write the lane back (awake, not a repeat)
+};
+
+// Per-region settings of a block.
+struct BlockParams {
+  float keep;                // 1 - damping
+  int length_iterations;
+  const float* spring_scale; // spring model: §4.4's tilt factor k_m / k per substep
+};
+
+// One substep's head pose and colliders, computed once per step for every block.
+struct Substep {
+  float m[9];  // head linear part, row-major
+  float t[3];  // head translation
+  float dt2;
+  const float* spheres;  // world-space x, y, z, r
+  int sphere_count;
+};
+
+struct Frame {
+  const Substep* substeps;
+  int substep_count;
+  float gravity[3];
+  float wind[3];  // wind acceleration; used only when windy
+  bool windy;
+};
+
+enum Stage : int { kReferences, kIntegrate, kLength, kCollision, kStageCount };
+
+// Advances one block by one frame: reads and writes the positions `pos` and the previous
+// positions `prev` (float4 per vertex, groom order) of the block's lanes that have
+// write[l] set. scratch holds scratch_floats(n) floats. With stage_ns non-null, adds the
+// nanoseconds spent in each Stage (callers pass it for a sample of blocks only).
+using FrameFn = void (*)(Model model, const Block& block, const BlockParams& params, const Frame& frame, float* pos,
+                         float* prev, float* scratch, std::int64_t* stage_ns);
+
+// The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline
+// build. Both give the same bits.
+FrameFn frame_kernel();
+// The baseline variant, for the tests that compare ISA variants.
+FrameFn frame_kernel_baseline();
+
+}  // namespace hairbench::kernels::halen_soa

@@ -1,0 +1,401 @@
+// The fused block kernel of halen_soa.h. This file is compiled once per ISA variant
+// (kernels/CMakeLists.txt), each time with HALEN_SOA_VARIANT naming the namespace; the
+// loops over lanes are written plainly so the compiler turns each into vector
+// instructions of that variant.
+#include "kernels/cpu/halen_soa.h"
+
+#include <chrono>
+#include <cmath>
+
+#ifndef HALEN_SOA_VARIANT
+#error "HALEN_SOA_VARIANT must name the ISA variant"
+#endif
+
+namespace hairbench::kernels::halen_soa::HALEN_SOA_VARIANT {
+
+namespace {
+
+constexpr int W = kLanes;
+
+#define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
+
+// The head transform in locals (no aliasing with the rows for the vectoriser), applied
+// as Eigen evaluates Affine3f · Vector3f: t + ((m00 x + m01 y) + m02 z).
+struct Pose {
+  float m0, m1, m2, m3, m4, m5, m6, m7, m8, t0, t1, t2;
+  explicit Pose(const Substep& s)
+      : m0(s.m[0]), m1(s.m[1]), m2(s.m[2]), m3(s.m[3]), m4(s.m[4]), m5(s.m[5]), m6(s.m[6]), m7(s.m[7]),
+        m8(s.m[8]), t0(s.t[0]), t1(s.t[1]), t2(s.t[2]) {}
+  float x(float a, float b, float c) const { return t0 + ((m0 * a + m1 * b) + m2 * c); }
+  float y(float a, float b, float c) const { return t1 + ((m3 * a + m4 * b) + m5 * c); }
+  float z(float a, float b, float c) const { return t2 + ((m6 * a + m7 * b) + m8 * c); }
+};
+
+class Clock {
+ public:
+  explicit Clock(std::int64_t* ns) : ns_(ns) {
+    if (ns_) last_ = now();
+  }
+  void lap(Stage s) {
+    if (!ns_) return;
+    const std::int64_t t = now();
+    ns_[s] += t - last_;
+    last_ = t;
+  }
+
+ private:
+  static std::int64_t now() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  std::int64_t* ns_;
+  std::int64_t last_ = 0;
+};
+
+// A block's rows: [component][vertex][lane].
+struct Rows {
+  int n;
+  float *px, *py, *pz, *qx, *qy, *qz;  // positions, previous positions
+  float *ux, *uy, *uz;                 // reference nodes (the cascade's upward ones)
+  float *dx, *dy, *dz;                 // the cascade's downward reference nodes
+  const float* c;                      // the block's fields
+  const RowKind* kind;
+  const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
+};
+
+// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest.
+void follow_head(const Rows& r, const Pose& h) {
+  for (int i = 0; i < r.n; ++i) {
+    if (r.kind[i] == kRowFree) continue;
+    const int o = i * W;
+    const float *rx = r.field(RX, i), *ry = r.field(RY, i), *rz = r.field(RZ, i), *iw = r.field(IW, i);
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+    LANES {
+      const bool pinned = iw[l] == 0.0f;
+      const float x = px[l], y = py[l], z = pz[l];
+      px[l] = pinned ? h.x(rx[l], ry[l], rz[l]) : x;
+      py[l] = pinned ? h.y(rx[l], ry[l], rz[l]) : y;
+      pz[l] = pinned ? h.z(rx[l], ry[l], rz[l]) : z;
+      qx[l] = pinned ? x : qx[l];
+      qy[l] = pinned ? y : qy[l];
+      qz[l] = pinned ? z : qz[l];
+    }
+  }
+}
+
+// Verlet with damping (verlet_integrate), row by row from vertex 1, so the wind term sees
+// vertex i-1 already moved, as in the per-strand kernel.
+template <bool kWindy>
+void verlet(const Rows& r, const Frame& f, float keep, float dt2) {
+  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
+  [[maybe_unused]] const float wx = f.wind[0], wy = f.wind[1], wz = f.wind[2];
+  const float gdx = gx * dt2, gdy = gy * dt2, gdz = gz * dt2;
+  for (int i = 1; i < r.n; ++i) {
+    if (r.kind[i] == kRowPinned) continue;
+    const int o = i * W;
+    const float* iw = r.field(IW, i);
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+    const float *ax = px - W, *ay = py - W, *az = pz - W;
+    LANES {
+      const bool free = iw[l] != 0.0f;
+      const float x = px[l], y = py[l], z = pz[l];
+      float ddx = gdx, ddy = gdy, ddz = gdz;
+      if constexpr (kWindy) {
+        const float ex = x - ax[l], ey = y - ay[l], ez = z - az[l];
+        const float len2 = ex * ex + (ey * ey + ez * ez);
+        const float len = std::sqrt(len2);
+        const bool ok = len2 > 0.0f;
+        const float tx = ok ? ex / len : 0.0f, ty = ok ? ey / len : 0.0f, tz = ok ? ez / len : 0.0f;
+        const float dw = wx * tx + (wy * ty + wz * tz);
+        ddx = (gx + (wx - dw * tx)) * dt2;
+        ddy = (gy + (wy - dw * ty)) * dt2;
+        ddz = (gz + (wz - dw * tz)) * dt2;
+      }
+      px[l] = free ? (x + keep * (x - qx[l])) + ddx : x;
+      py[l] = free ? (y + keep * (y - qy[l])) + ddy : y;
+      pz[l] = free ? (z + keep * (z - qz[l])) + ddz : z;
+      qx[l] = free ? x : qx[l];
+      qy[l] = free ? y : qy[l];
+      qz[l] = free ? z : qz[l];
+    }
+  }
+}
+
+// Zero-rest-length springs (add_spring_acceleration) towards the reference nodes
+// (rx, ry, rz) with stiffness field `kf`, on rows [0, end): p += (scale k dt²)(ref - p_start).
+void springs(const Rows& r, int kf, const float* rx, const float* ry, const float* rz, int end, float scale,
+             float dt2) {
+  for (int i = 0; i < end; ++i) {
+    if (r.kind[i] == kRowPinned) continue;
+    const int o = i * W;
+    const float *iw = r.field(IW, i), *k = r.field(kf, i);
+    const float *ax = rx + o, *ay = ry + o, *az = rz + o;
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    const float *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+    LANES {
+      const bool free = iw[l] != 0.0f;
+      const float c = (scale * k[l]) * dt2;
+      px[l] = free ? px[l] + c * (ax[l] - qx[l]) : px[l];
+      py[l] = free ? py[l] + c * (ay[l] - qy[l]) : py[l];
+      pz[l] = free ? pz[l] + c * (az[l] - qz[l]) : pz[l];
+    }
+  }
+}
+
+// Edge length constraints (edge_length): odd edges, then even ones, mass-weighted.
+void edge_length(const Rows& r) {
+  for (int first : {1, 2})
+    for (int i = first; i < r.n; i += 2) {
+      if (r.kind[i] == kRowPinned && r.kind[i - 1] == kRowPinned) continue;
+      const int o = i * W;
+      const float *aw = r.field(IW, i - 1), *bw = r.field(IW, i), *rl = r.field(RL, i);
+      float *ax = r.px + o - W, *ay = r.py + o - W, *az = r.pz + o - W;
+      float *bx = r.px + o, *by = r.py + o, *bz = r.pz + o;
+      LANES {
+        const float wsum = aw[l] + bw[l];
+        const float dx = bx[l] - ax[l], dy = by[l] - ay[l], dz = bz[l] - az[l];
+        const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
+        const bool on = wsum != 0.0f && len > 0.0f;
+        const float s = (len - rl[l]) / (len * wsum);
+        const float cx = dx * s, cy = dy * s, cz = dz * s;
+        ax[l] = on ? ax[l] + aw[l] * cx : ax[l];
+        ay[l] = on ? ay[l] + aw[l] * cy : ay[l];
+        az[l] = on ? az[l] + aw[l] * cz : az[l];
+        bx[l] = on ? bx[l] - bw[l] * cx : bx[l];
+        by[l] = on ? by[l] - bw[l] * cy : by[l];
+        bz[l] = on ? bz[l] - bw[l] * cz : bz[l];
+      }
+    }
+}
+
+// Sphere collisions (collide_spheres): up to four passes; a pass that moves no lane of a
+// row ends it (a lane that did not move would not move in a further pass either).
+void collide(const Rows& r, const Substep& s) {
+  constexpr int kPasses = 4;
+  for (int i = 0; i < r.n; ++i) {
+    if (r.kind[i] == kRowPinned) continue;
+    const int o = i * W;
+    const float* iw = r.field(IW, i);
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      int moved = 0;
+      for (int c = 0; c < s.sphere_count; ++c) {
+        const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
+                    rad = s.spheres[4 * c + 3];
+        LANES {
+          const float dx = px[l] - sx, dy = py[l] - sy, dz = pz[l] - sz;
+          const float dist2 = dx * dx + (dy * dy + dz * dz);
+          const bool in = iw[l] != 0.0f && !(dist2 >= rad * rad);
+          const float dist = std::sqrt(dist2);
+          const bool off = dist > 0.0f;
+          const float nx = off ? dx / dist : 0.0f, ny = off ? dy / dist : 1.0f, nz = off ? dz / dist : 0.0f;
+          px[l] = in ? sx + nx * rad : px[l];
+          py[l] = in ? sy + ny * rad : py[l];
+          pz[l] = in ? sz + nz * rad : pz[l];
+          moved |= in;
+        }
+      }
+      if (!moved) break;
+    }
+  }
+}
+
+// §4.4: reference nodes rigid with the head, lifted against gravity (head_references).
+void spring_references(const Rows& r, const Pose& h, const Frame& f) {
+  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
+  for (int i = 0; i < r.n; ++i) {
+    const int o = i * W;
+    const float *rx = r.field(RX, i), *ry = r.field(RY, i), *rz = r.field(RZ, i), *lift = r.field(LIFT, i);
+    float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
+    LANES {
+      ux[l] = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];
+      uy[l] = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
+      uz[l] = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
+    }
+  }
+}
+
+// A tangent space [B N T] of every lane, column by column.
+struct Space {
+  alignas(64) float v[9][W];
+};
+
+// A reference node M · local + origin - gravity · lift (cascade_references) into row `out`.
+inline void place(const Space& m, const float* lx, const float* ly, const float* lz, const float* ox,
+                  const float* oy, const float* oz, const float* lift, const Frame& f, float* x, float* y,
+                  float* z) {
+  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
+  LANES {
+    const float a = lx[l], b = ly[l], c = lz[l];
+    x[l] = (m.v[0][l] * a + (m.v[3][l] * b + m.v[6][l] * c) + ox[l]) - gx * lift[l];
+    y[l] = (m.v[1][l] * a + (m.v[4][l] * b + m.v[7][l] * c) + oy[l]) - gy * lift[l];
+    z[l] = (m.v[2][l] * a + (m.v[5][l] * b + m.v[8][l] * c) + oz[l]) - gz * lift[l];
+  }
+}
+
+// §4.3's first two steps (tangent_spaces, cascade_references): the tangent spaces from
+// the root up, each used at once for the upward reference node of the vertex above it
+// and the downward one of the vertex two below it.
+void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
+  const int n = r.n;
+  const float* rest_space = r.c + static_cast<std::size_t>(kCascadeFields) * n * W;
+  // The root segment's space, rigid with the head: head rotation · rest space.
+  Space parent;
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row) {
+      const float h0 = s.m[3 * row], h1 = s.m[3 * row + 1], h2 = s.m[3 * row + 2];
+      const float *s0 = rest_space + (3 * col) * W, *s1 = s0 + W, *s2 = s1 + W;
+      float* out = parent.v[3 * col + row];
+      LANES { out[l] = h0 * s0[l] + (h1 * s1[l] + h2 * s2[l]); }
+    }
+  // Rows 0 and 1 have no upward reference node; their springs have k = 0 and pull
+  // towards the origin, as the reference's never-written entries.
+  for (int i = 0; i < 2 && i < n; ++i)
+    LANES {
+      r.ux[i * W + l] = 0.0f;
+      r.uy[i * W + l] = 0.0f;
+      r.uz[i * W + l] = 0.0f;
+    }
+  auto up = [&](const Space& m, int i) {  // vertex i in the space of segment i-1
+    const int o = i * W, p = o - W;
+    place(m, r.field(UX, i), r.field(UY, i), r.field(UZ, i), r.px + p, r.py + p, r.pz + p, r.field(LIFT, i), f,
+          r.ux + o, r.uy + o, r.uz + o);
+  };
+  auto down = [&](const Space& m, int i) {  // vertex i in the space of segment i+2
+    const int o = i * W, p = o + 2 * W;
+    place(m, r.field(DX, i), r.field(DY, i), r.field(DZ, i), r.px + p, r.py + p, r.pz + p, r.field(LIFT, i), f,
+          r.dx + o, r.dy + o, r.dz + o);
+  };
+  if (n > 2) up(parent, 2);
+  Space cur;
+  for (int i = 2; i < n; ++i) {
+    const int o = i * W;
+    const float *ax = r.px + o - W, *ay = r.py + o - W, *az = r.pz + o - W;
+    const float *bx = r.px + o, *by = r.py + o, *bz = r.pz + o;
+    LANES {
+      const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
+      const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
+      const bool ok = len > 0.0f;
+      const float nx = ex / len, ny = ey / len, nz = ez / len;
+      const float Tx = parent.v[6][l], Ty = parent.v[7][l], Tz = parent.v[8][l];
+      float b0 = ny * Tz - nz * Ty, b1 = nz * Tx - nx * Tz, b2 = nx * Ty - ny * Tx;
+      const float bl = std::sqrt(b0 * b0 + (b1 * b1 + b2 * b2));
+      // N parallel to the parent's T: B_{n-1} made perpendicular to N.
+      const float Bx = parent.v[0][l], By = parent.v[1][l], Bz = parent.v[2][l];
+      const float dot = Bx * nx + (By * ny + Bz * nz);
+      const float vx = Bx - dot * nx, vy = By - dot * ny, vz = Bz - dot * nz;
+      const float vn2 = vx * vx + (vy * vy + vz * vz);
+      const float vn = std::sqrt(vn2);
+      const bool wide = bl > 1e-6f;
+      b0 = wide ? b0 / bl : vn2 > 0.0f ? vx / vn : vx;
+      b1 = wide ? b1 / bl : vn2 > 0.0f ? vy / vn : vy;
+      b2 = wide ? b2 / bl : vn2 > 0.0f ? vz / vn : vz;
+      cur.v[0][l] = ok ? b0 : Bx;
+      cur.v[1][l] = ok ? b1 : By;
+      cur.v[2][l] = ok ? b2 : Bz;
+      cur.v[3][l] = ok ? nx : parent.v[3][l];
+      cur.v[4][l] = ok ? ny : parent.v[4][l];
+      cur.v[5][l] = ok ? nz : parent.v[5][l];
+      cur.v[6][l] = ok ? ny * b2 - nz * b1 : Tx;
+      cur.v[7][l] = ok ? nz * b0 - nx * b2 : Ty;
+      cur.v[8][l] = ok ? nx * b1 - ny * b0 : Tz;
+    }
+    if (i + 1 < n) up(cur, i + 1);
+    down(cur, i - 2);
+    parent = cur;
+  }
+}
+
+template <Model kModel>
+void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* pos, float* prev, float* scratch,
+                std::int64_t* stage_ns) {
+  const int n = b.n;
+  const std::size_t rows = static_cast<std::size_t>(n) * W;
+  Rows r{n,
+         scratch,
+         scratch + rows,
+         scratch + 2 * rows,
+         scratch + 3 * rows,
+         scratch + 4 * rows,
+         scratch + 5 * rows,
+         scratch + 6 * rows,
+         scratch + 7 * rows,
+         scratch + 8 * rows,
+         scratch + 9 * rows,
+         scratch + 10 * rows,
+         scratch + 11 * rows,
+         b.data,
+         b.rows};
+  Clock clock(stage_ns);
+  for (int l = 0; l < W; ++l) {
+    const float* s = pos + static_cast<std::size_t>(b.offset[l]) * 4;
+    const float* q = prev + static_cast<std::size_t>(b.offset[l]) * 4;
+    for (int i = 0; i < n; ++i) {
+      r.px[i * W + l] = s[4 * i];
+      r.py[i * W + l] = s[4 * i + 1];
+      r.pz[i * W + l] = s[4 * i + 2];
+      r.qx[i * W + l] = q[4 * i];
+      r.qy[i * W + l] = q[4 * i + 1];
+      r.qz[i * W + l] = q[4 * i + 2];
+    }
+  }
+  clock.lap(kIntegrate);
+  for (int k = 0; k < f.substep_count; ++k) {
+    const Substep& s = f.substeps[k];
+    const Pose h(s);
+    if constexpr (kModel == Model::Spring) {
+      spring_references(r, h, f);
+      clock.lap(kReferences);
+      follow_head(r, h);
+    } else {
+      follow_head(r, h);
+      cascade_references(r, s, f);
+      clock.lap(kReferences);
+    }
+    if (f.windy)
+      verlet<true>(r, f, p.keep, s.dt2);
+    else
+      verlet<false>(r, f, p.keep, s.dt2);
+    if constexpr (kModel == Model::Spring) {
+      springs(r, KU, r.ux, r.uy, r.uz, n, p.spring_scale[k], s.dt2);
+    } else {
+      springs(r, KU, r.ux, r.uy, r.uz, n, 1.0f, s.dt2);
+      springs(r, KD, r.dx, r.dy, r.dz, n - 2, 1.0f, s.dt2);
+    }
+    clock.lap(kIntegrate);
+    for (int it = 0; it < p.length_iterations; ++it) edge_length(r);
+    clock.lap(kLength);
+    if (s.sphere_count > 0) {
+      collide(r, s);
+      clock.lap(kCollision);
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    if (!b.write[l]) continue;
+    float* s = pos + static_cast<std::size_t>(b.offset[l]) * 4;
+    float* q = prev + static_cast<std::size_t>(b.offset[l]) * 4;
+    for (int i = 0; i < n; ++i) {
+      s[4 * i] = r.px[i * W + l];
+      s[4 * i + 1] = r.py[i * W + l];
+      s[4 * i + 2] = r.pz[i * W + l];
+      q[4 * i] = r.qx[i * W + l];
+      q[4 * i + 1] = r.qy[i * W + l];
+      q[4 * i + 2] = r.qz[i * W + l];
+    }
+  }
+  clock.lap(kIntegrate);
+}
+
+void frame(Model model, const Block& b, const BlockParams& p, const Frame& f, float* pos, float* prev,
+           float* scratch, std::int64_t* stage_ns) {
+  if (model == Model::Spring)
+    frame_impl<Model::Spring>(b, p, f, pos, prev, scratch, stage_ns);
+  else
+    frame_impl<Model::Cascade>(b, p, f, pos, prev, scratch, stage_ns);
+}
+
+}  // namespace
+
+FrameFn frame_fn() { return &frame; }
+
+}  // namespace hairbench::kernels::halen_soa::HALEN_SOA_VARIANT

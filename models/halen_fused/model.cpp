@@ -1,0 +1,301 @@
+#include "models/halen_fused/model.h"
+
+#include "core/parallel.h"
+#include "kernels/cpu/halen_kernels.h"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+
+namespace hairbench::halen_fused {
+
+namespace soa = hairbench::kernels::halen_soa;
+namespace k = hairbench::kernels;
+
+// One block in this many (and the first of every region) times its stages.
+constexpr std::size_t kSampleEvery = 16;
+
+HalenFusedModel::HalenFusedModel(Model model, const ModelContext& ctx)
+    : model_(model), ctx_(ctx), kernel_(soa::frame_kernel()) {}
+
+void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
+  const bool spring = model_ == Model::Spring;
+  region_.clear();
+  for (std::size_t r = 0; r < rest.region_names.size(); ++r)
+    region_.push_back({1.0f - static_cast<float>(params.get("damping", r)),
+                       spring ? static_cast<float>(params.get("tilt_min", r)) : 1.0f,
+                       params.get_int("length_iterations", r)});
+  substeps_ = params.get_int("substeps");
+
+  // Per-vertex constants, with the set-up the reference models use.
+  const std::size_t nv = rest.vertex_count();
+  const std::vector<float> rest_length = rest_edge_lengths(rest);
+  std::vector<float> k_up(nv), k_down(nv), lift(nv);
+  std::vector<k::Mat3f> rest_space(spring ? 0 : nv);
+  std::vector<Vec3f> up_local(spring ? 0 : nv), down_local(spring ? 0 : nv);
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
+    const auto strand_rest = std::span(rest.positions).subspan(b, n);
+    const float stiffness = static_cast<float>(params.get("stiffness", r));
+    const float c = static_cast<float>(params.get("falloff_scale", r));
+    const int a = params.get_int("falloff_exponent", r);
+    if (spring)
+      k::spring_setup(strand_rest, stiffness, c, a, std::span(k_up).subspan(b, n), std::span(lift).subspan(b, n));
+    else
+      k::cascade_setup(strand_rest, stiffness, c, a, static_cast<float>(params.get("down_fraction", r)),
+                       std::span(k_up).subspan(b, n), std::span(k_down).subspan(b, n),
+                       std::span(rest_space).subspan(b, n), std::span(up_local).subspan(b, n),
+                       std::span(down_local).subspan(b, n), std::span(lift).subspan(b, n));
+  }
+
+  // Blocks: strands of one region and one vertex count, W at a time (ragged grooms give
+  // one partly filled block per (region, count); its idle lanes repeat a strand of the
+  // block and are never written back).
+  std::vector<std::uint32_t> order(rest.strand_count());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (rest.strand_region[a] != rest.strand_region[b]) return rest.strand_region[a] < rest.strand_region[b];
+    return rest.strand_size(a) < rest.strand_size(b);
+  });
+  blocks_.clear();
+  row_kinds_.clear();
+  std::size_t floats = 0;
+  int max_n = 0;
+  for (std::size_t i = 0; i < order.size();) {
+    const std::uint16_t region = rest.strand_region[order[i]];
+    const int n = static_cast<int>(rest.strand_size(order[i]));
+    std::size_t j = i;
+    while (j < order.size() && j - i < static_cast<std::size_t>(W) && rest.strand_region[order[j]] == region &&
+           static_cast<int>(rest.strand_size(order[j])) == n)
+      ++j;
+    BlockInfo b;
+    b.offset = floats;
+    b.rows = row_kinds_.size();
+    b.n = n;
+    b.region = region;
+    b.sampled = blocks_.size() % kSampleEvery == 0 || blocks_.empty() || blocks_.back().region != region;
+    for (int l = 0; l < W; ++l) {
+      const bool used = i + static_cast<std::size_t>(l) < j;
+      const std::uint32_t s = order[used ? i + l : j - 1];
+      b.offset_of[l] = rest.strand_begin(s);
+      b.strand[l] = used ? s : kNoStrand;
+    }
+    for (int v = 0; v < n; ++v) {
+      int pinned = 0;
+      for (int l = 0; l < W; ++l) pinned += rest.positions[b.offset_of[l] + v].w() == 0.0f;
+      row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
+    }
+    floats += soa::block_floats(model_, n);
+    max_n = std::max(max_n, n);
+    blocks_.push_back(b);
+    i = j;
+  }
+  data_.assign(floats, 0.0f);
+  for (const BlockInfo& b : blocks_) {
+    float* d = data_.data() + b.offset;
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    auto at = [&](int field, int i, int l) -> float& { return d[field * rows + static_cast<std::size_t>(i) * W + l]; };
+    for (int l = 0; l < W; ++l)
+      for (int i = 0; i < b.n; ++i) {
+        const std::size_t v = b.offset_of[l] + static_cast<std::size_t>(i);
+        const Vec4f& p0 = rest.positions[v];
+        at(soa::RX, i, l) = p0.x();
+        at(soa::RY, i, l) = p0.y();
+        at(soa::RZ, i, l) = p0.z();
+        at(soa::IW, i, l) = p0.w();
+        at(soa::RL, i, l) = rest_length[v];
+        at(soa::LIFT, i, l) = lift[v];
+        at(soa::KU, i, l) = k_up[v];
+        if (spring) continue;
+        at(soa::KD, i, l) = k_down[v];
+        for (int c = 0; c < 3; ++c) {
+          at(soa::UX + c, i, l) = up_local[v][c];
+          at(soa::DX + c, i, l) = down_local[v][c];
+        }
+        if (i == 1) {  // the root segment's rest space, column by column
+          float* root = d + static_cast<std::size_t>(soa::kCascadeFields) * rows;
+          for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) root[(3 * c + r) * W + l] = rest_space[v](r, c);
+        }
+      }
+  }
+
+  // Static partition of the blocks over the threads by estimated cost (vertices times
+  // passes over them), fixed at reset: which thread runs a block never changes a bit of
+  // its result, so any thread count gives the same state.
+  const int threads = ctx_.pool ? ctx_.pool->threads() : 1;
+  std::vector<double> cost(blocks_.size());
+  double total = 0.0;
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    cost[b] = blocks_[b].n * (4.0 + region_[blocks_[b].region].length_iterations);
+    total += cost[b];
+  }
+  threads_.assign(static_cast<std::size_t>(threads), ThreadState{});
+  double acc = 0.0;
+  std::size_t next = 0;
+  for (int t = 0; t < threads; ++t) {
+    threads_[t].first = next;
+    const double end = total * (t + 1) / threads;
+    while (next < blocks_.size() && (t == threads - 1 || acc + 0.5 * cost[next] < end)) acc += cost[next++];
+    threads_[t].last = next;
+  }
+  scratch_stride_ = soa::scratch_floats(max_n);
+  scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
+  write_.assign(blocks_.size() * W, 0);
+  substep_.assign(static_cast<std::size_t>(substeps_), soa::Substep{});
+  spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
+  spring_scale_.assign(region_.size() * static_cast<std::size_t>(substeps_), 1.0f);
+  strand_begin_.resize(rest.strand_count());
+  strand_size_.resize(rest.strand_count());
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    strand_begin_[s] = rest.strand_begin(s);
+    strand_size_[s] = rest.strand_size(s);
+  }
+  pos_ = rest.positions;
+  prev_ = rest.positions;
+  sleep_.reset(rest.strand_count());
+}
+
+std::size_t HalenFusedModel::state_bytes() const {
+  return data_.size() * sizeof(float) + (pos_.size() + prev_.size()) * sizeof(Vec4f);
+}
+
+void HalenFusedModel::run_thread(int t) {
+  ThreadState& ts = threads_[static_cast<std::size_t>(t)];
+  float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
+  float* pos = pos_.data()->data();
+  float* prev = prev_.data()->data();
+  for (std::size_t i = ts.first; i < ts.last; ++i) {
+    const BlockInfo& b = blocks_[i];
+    std::uint8_t* write = write_.data() + i * W;
+    int awake = 0;
+    for (int l = 0; l < W; ++l) {
+      write[l] = b.strand[l] != kNoStrand && !(calm_ && sleep_.asleep(b.strand[l]));
+      awake += write[l];
+    }
+    if (awake == 0) continue;  // every strand of the block sleeps
+    const Region& r = region_[b.region];
+    const soa::BlockParams p{r.keep, r.length_iterations,
+                             spring_scale_.data() + static_cast<std::size_t>(b.region) * substep_.size()};
+    const soa::Block block{data_.data() + b.offset, b.n, b.offset_of.data(), row_kinds_.data() + b.rows, write};
+    if (!b.sampled) {
+      kernel_(model_, block, p, frame_, pos, prev, scratch, nullptr);
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      kernel_(model_, block, p, frame_, pos, prev, scratch, ts.stage_ns.data());
+      ts.sampled_ns +=
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
+    }
+  }
+}
+
+// StrandSleep::observe for every awake strand of this thread's blocks.
+void HalenFusedModel::observe_sleep(int t, float dt) {
+  const ThreadState& ts = threads_[static_cast<std::size_t>(t)];
+  for (std::size_t i = ts.first; i < ts.last; ++i)
+    for (std::uint32_t s : blocks_[i].strand) {
+      if (s == kNoStrand || sleep_.asleep(s)) continue;
+      sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(strand_begin_[s], strand_size_[s]),
+                     std::span<const Vec4f>(prev_).subspan(strand_begin_[s], strand_size_[s]), dt);
+    }
+}
+
+void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
+  calm_ = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm_ && sleep_.all_asleep()) {
+    // Every strand sleeps: nothing runs (issue 8).
+    for (std::string_view stage : {"references", "integrate", "length", "collision"}) times.skip(stage);
+    return;
+  }
+  const FramePlan plan = plan_frame(in, ctx_);
+  const auto start = std::chrono::steady_clock::now();
+  const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const std::size_t nc = plan.collision ? in.colliders.size() : 0;
+  // Grows only when a scene has more colliders than any before (reserved for 16).
+  if (spheres_.size() < nc * 4 * substep_.size()) spheres_.resize(nc * 4 * substep_.size());
+  // §4.4: "z is the up vector, z_h the up vector of the head" — up is against gravity.
+  const Vec3f up = in.gravity.squaredNorm() > 0.0f ? Vec3f(-in.gravity.normalized()) : Vec3f::UnitY();
+  for (int i = 1; i <= substeps_; ++i) {
+    const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(substeps_));
+    soa::Substep& s = substep_[static_cast<std::size_t>(i - 1)];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) s.m[3 * r + c] = head.linear()(r, c);
+      s.t[r] = head.translation()[r];
+    }
+    s.dt2 = dt * dt;
+    float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const Vec3f center = collider_center(in.colliders[c], head);
+      sp[4 * c] = center.x();
+      sp[4 * c + 1] = center.y();
+      sp[4 * c + 2] = center.z();
+      sp[4 * c + 3] = in.colliders[c].radius;
+    }
+    s.spheres = sp;
+    s.sphere_count = static_cast<int>(nc);
+    if (model_ == Model::Spring) {
+      const Vec3f head_up = head.linear() * up;
+      for (std::size_t r = 0; r < region_.size(); ++r)
+        spring_scale_[r * substep_.size() + static_cast<std::size_t>(i - 1)] =
+            k::tilt_factor(up, head_up, region_[r].tilt_min);
+    }
+  }
+  frame_.substeps = substep_.data();
+  frame_.substep_count = substeps_;
+  const Vec3f wind = in.wind.acceleration();
+  for (int c = 0; c < 3; ++c) {
+    frame_.gravity[c] = in.gravity[c];
+    frame_.wind[c] = wind[c];
+  }
+  frame_.windy = plan.wind;  // no wind, no wind term
+
+  for (ThreadState& ts : threads_) {
+    ts.stage_ns.fill(0);
+    ts.sampled_ns = 0;
+  }
+  HalenFusedModel* self = this;  // one pointer: the std::function stores it without allocating
+  if (ctx_.pool)
+    ctx_.pool->parallel_for(threads_.size(), [self](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) self->run_thread(static_cast<int>(t));
+    });
+  else
+    run_thread(0);
+
+  // Per-stage times without a clock read per stage per block: the sampled blocks time
+  // their stages; each stage's share of their time, times the step's wall time, is the
+  // stage's time.
+  const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::array<std::int64_t, soa::kStageCount> ns{};
+  std::int64_t sampled = 0;
+  for (const ThreadState& ts : threads_) {
+    for (int s = 0; s < soa::kStageCount; ++s) ns[s] += ts.stage_ns[s];
+    sampled += ts.sampled_ns;
+  }
+  auto report = [&](std::string_view name, soa::Stage s, bool ran) {
+    if (!ran) {
+      times.skip(name);
+      return;
+    }
+    times.add(name, sampled > 0 ? wall_ms * static_cast<double>(ns[s]) / static_cast<double>(sampled) : 0.0);
+  };
+  report("references", soa::kReferences, true);
+  report("integrate", soa::kIntegrate, true);
+  report("length", soa::kLength, true);
+  report("collision", soa::kCollision, plan.collision);
+  if (calm_) {
+    StageTimer t(times, "sleep");
+    if (ctx_.pool)
+      ctx_.pool->parallel_for(threads_.size(), [self, dt](std::size_t b, std::size_t e) {
+        for (std::size_t t = b; t < e; ++t) self->observe_sleep(static_cast<int>(t), dt);
+      });
+    else
+      observe_sleep(0, dt);
+    sleep_.end_observe();
+  }
+}
+
+std::unique_ptr<HairModel> make(Model model, const ModelContext& ctx) {
+  return std::make_unique<HalenFusedModel>(model, ctx);
+}
+
+}  // namespace hairbench::halen_fused

@@ -1,0 +1,80 @@
+// The fused Halén & Wester 2007 spring (§4.4) and cascading spaces (§4.3) models
+// (halen_spring, halen_cascade): the physics of models/halen_spring and
+// models/halen_cascade (registered as halen_*_ref), run as one structure-of-arrays pass
+// per block of 16 strands through all substeps (kernels/cpu/halen_soa.h), bit-identical
+// to the references for any thread count. Blocks are partitioned statically over the
+// threads at reset; a step allocates nothing and makes no virtual call.
+#pragma once
+
+#include "core/hair_model.h"
+#include "core/sleep.h"
+#include "kernels/cpu/halen_soa.h"
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace hairbench::halen_fused {
+
+using kernels::halen_soa::Model;
+
+class HalenFusedModel final : public HairModel {
+ public:
+  HalenFusedModel(Model model, const ModelContext& ctx);
+  void reset(const Groom& rest, const ParamSet& params) override;
+  void step(const FrameInput& in, StageTimes& out_times) override;
+  std::span<const Vec4f> positions() const override { return pos_; }
+  // The blocks' fields and the positions and previous positions.
+  std::size_t state_bytes() const override;
+  // Replaces the run-time chosen kernel variant (tests compare the variants).
+  void use_kernel(kernels::halen_soa::FrameFn fn) { kernel_ = fn; }
+
+ private:
+  static constexpr int W = kernels::halen_soa::kLanes;
+  struct Region {
+    float keep, tilt_min;
+    int length_iterations;
+  };
+  struct BlockInfo {
+    std::size_t offset = 0;     // into data_
+    std::size_t rows = 0;       // into row_kinds_
+    int n = 0;
+    std::uint16_t region = 0;
+    bool sampled = false;       // times its stages
+    std::array<std::uint32_t, W> offset_of{};  // per lane: first vertex of its strand
+    std::array<std::uint32_t, W> strand{};     // per lane: the strand, or kNoStrand for a repeat
+  };
+  struct ThreadState {
+    std::size_t first = 0, last = 0;  // blocks
+    std::array<std::int64_t, kernels::halen_soa::kStageCount> stage_ns{};
+    std::int64_t sampled_ns = 0;
+  };
+  static constexpr std::uint32_t kNoStrand = 0xffffffffu;
+  void run_thread(int t);
+  void observe_sleep(int t, float dt);
+
+  Model model_;
+  ModelContext ctx_;
+  kernels::halen_soa::FrameFn kernel_;
+  std::vector<Region> region_;
+  int substeps_ = 1;
+  std::vector<BlockInfo> blocks_;
+  std::vector<float> data_;
+  std::vector<kernels::halen_soa::RowKind> row_kinds_;
+  std::vector<std::uint8_t> write_;  // per block and lane, refreshed every step
+  std::vector<ThreadState> threads_;
+  std::vector<float> scratch_;
+  std::size_t scratch_stride_ = 0;
+  std::vector<kernels::halen_soa::Substep> substep_;
+  std::vector<float> spheres_;        // per substep, x y z r per collider
+  std::vector<float> spring_scale_;   // per region and substep: §4.4's tilt factor
+  kernels::halen_soa::Frame frame_{};
+  bool calm_ = false;
+  StrandSleep sleep_;
+  std::vector<std::uint32_t> strand_begin_, strand_size_;
+  std::vector<Vec4f> pos_, prev_;
+};
+
+std::unique_ptr<HairModel> make(Model model, const ModelContext& ctx);
+
+}  // namespace hairbench::halen_fused

@@ -1,0 +1,168 @@
+// The fused structure-of-arrays Halén & Wester models (halen_spring, halen_cascade;
+// models/halen_fused) against the per-stage reference implementations (halen_*_ref):
+// the fused kernel performs every strand's floating-point operations in the reference's
+// order, so the states must agree bit for bit, frame after frame, on equal and ragged
+// grooms, with and without wind and colliders, through sleep and wake; and the state must
+// not depend on the thread count or on the ISA variant of the kernel.
+#include "test_support.h"
+
+#include "core/parallel.h"
+#include "kernels/cpu/halen_soa.h"
+#include "models/halen_fused/model.h"
+#include "models/registry.h"
+#include "reports/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+#include <set>
+
+namespace hairbench {
+namespace {
+
+Scenario paper_model1(std::size_t keep_every) {
+  Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_PAPER_SCENARIO_DIR) / "han2012_model1.json");
+  sc.groom = every_nth_strand(sc.groom, keep_every);
+  return sc;
+}
+
+std::unique_ptr<HairModel> make(const std::string& name, const Scenario& sc, const std::vector<ParamOverride>& ov,
+                                ThreadPool& pool, bool skip_inert = true) {
+  const ModelInfo* info = find_model(name);
+  if (!info) throw std::runtime_error("no model " + name);
+  return make_model(*info, sc, resolve_params(*info, sc, ov), pool, "", skip_inert);
+}
+
+// Steps two models in lockstep; the first frame whose positions differ in any bit, or
+// -1. `max_diff` gets the largest coordinate difference over all frames.
+int first_difference(const Scenario& sc, const std::string& a, const std::string& b, int frames,
+                     const std::vector<ParamOverride>& ov, double* max_diff = nullptr, bool skip_inert = true) {
+  ThreadPool pool(2);
+  auto ma = make(a, sc, ov, pool, skip_inert);
+  auto mb = make(b, sc, ov, pool, skip_inert);
+  int first = -1;
+  double worst = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    const FrameInput in = frame_input(sc, f);
+    StageTimes t;
+    ma->step(in, t);
+    mb->step(in, t);
+    const auto pa = ma->positions(), pb = mb->positions();
+    if (first < 0 && std::memcmp(pa.data(), pb.data(), pa.size_bytes()) != 0) first = f;
+    for (std::size_t i = 0; i < pa.size(); ++i) worst = std::max(worst, double((pa[i] - pb[i]).cwiseAbs().maxCoeff()));
+  }
+  if (max_diff) *max_diff = worst;
+  return first;
+}
+
+const std::vector<std::string> kFused = {"halen_spring", "halen_cascade"};
+
+TEST(HalenFused, BitIdenticalToReferenceOnShake) {
+  const Scenario sc = test::builtin("shake", 8);
+  for (const std::string& m : kFused) {
+    double diff = 0.0;
+    EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}, &diff), -1) << m << " max diff " << diff;
+  }
+}
+
+TEST(HalenFused, BitIdenticalToReferenceInWind) {
+  const Scenario sc = test::builtin("wind_gust", 16);
+  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
+}
+
+// §4.4's tilt weakening changes the spring scale every substep.
+TEST(HalenFused, BitIdenticalToReferenceUpsideDown) {
+  const Scenario sc = test::builtin("tilt_upside_down", 16);
+  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
+}
+
+// The Table 1 model-1 groom: three regions, ragged vertex counts (partly filled blocks),
+// three colliders.
+TEST(HalenFused, BitIdenticalToReferenceOnRaggedPaperGroom) {
+  const Scenario sc = paper_model1(16);
+  std::set<std::uint32_t> sizes;
+  for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) sizes.insert(sc.groom.strand_size(s));
+  ASSERT_GT(sizes.size(), 1u) << "the groom should be ragged";
+  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, {}), -1) << m;
+}
+
+// Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
+// and wake when the head turns, in both implementations.
+TEST(HalenFused, BitIdenticalToReferenceThroughSleepAndWake) {
+  Scenario sc = test::builtin("idle", 16);
+  sc.frames = 200;
+  Oscillator turn;
+  turn.kind = Oscillator::Kind::Rotate;
+  turn.amplitude = 0.5;
+  turn.start = 2.0;
+  turn.end = 10.0;
+  sc.head.oscillators = {turn};
+  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
+}
+
+// --no-skip (ModelContext::skip_inert off): every stage and term runs, nothing sleeps.
+TEST(HalenFused, BitIdenticalToReferenceWithoutSkipping) {
+  const Scenario sc = test::builtin("idle", 16);
+  for (const std::string& m : kFused)
+    EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}, nullptr, false), -1) << m;
+}
+
+std::uint64_t state_hash_after(const Scenario& sc, const std::string& model, int threads, int frames) {
+  ThreadPool pool(threads);
+  auto m = make(model, sc, {}, pool);
+  for (int f = 0; f < frames; ++f) {
+    StageTimes t;
+    m->step(frame_input(sc, f), t);
+  }
+  return metrics::state_hash(m->positions());
+}
+
+TEST(HalenFused, StateHashIndependentOfThreadCount) {
+  const Scenario sc = paper_model1(8);
+  for (const std::string& m : kFused) {
+    const auto one = state_hash_after(sc, m, 1, 20);
+    EXPECT_EQ(one, state_hash_after(sc, m, 2, 20)) << m;
+    EXPECT_EQ(one, state_hash_after(sc, m, 3, 20)) << m;
+  }
+}
+
+TEST(HalenFused, IsaVariantsGiveTheSameBits) {
+  const Scenario sc = paper_model1(16);
+  ThreadPool pool(2);
+  for (const std::string& name : kFused) {
+    const auto model = name == "halen_spring" ? halen_fused::Model::Spring : halen_fused::Model::Cascade;
+    const ParamSet params = resolve_params(*find_model(name), sc, {});
+    halen_fused::HalenFusedModel best(model, ModelContext{&pool}), base(model, ModelContext{&pool});
+    base.use_kernel(kernels::halen_soa::frame_kernel_baseline());
+    best.reset(sc.groom, params);
+    base.reset(sc.groom, params);
+    for (int f = 0; f < 30; ++f) {
+      StageTimes t;
+      best.step(frame_input(sc, f), t);
+      base.step(frame_input(sc, f), t);
+    }
+    EXPECT_EQ(metrics::state_hash(best.positions()), metrics::state_hash(base.positions())) << name;
+  }
+}
+
+// The stages of the reference are reported, collisions skipped without colliders.
+TEST(HalenFused, StagesAreReported) {
+  const Scenario sc = test::builtin("shake", 16);
+  ThreadPool pool(2);
+  for (const std::string& name : kFused) {
+    auto m = make(name, sc, {}, pool);
+    FrameInput in = frame_input(sc, 0);
+    in.colliders = {};
+    StageTimes t;
+    m->step(in, t);
+    std::map<std::string, bool> skipped;
+    for (const auto& e : t.entries()) skipped[std::string(e.name)] = e.skipped;
+    EXPECT_EQ(skipped, (std::map<std::string, bool>{
+                           {"references", false}, {"integrate", false}, {"length", false}, {"collision", true}}))
+        << name;
+  }
+}
+
+}  // namespace
+}  // namespace hairbench
