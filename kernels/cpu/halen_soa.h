@@ -1,10 +1,11 @@
 // Halén & Wester 2007's spring (§4.4) and cascading spaces (§4.3) models as one fused
 // pass per block of strands, structure of arrays: a block holds kLanes strands of one
 // region and one vertex count, field by field and vertex by vertex ([field][vertex][lane]),
-// so one vector instruction advances kLanes strands. The pass gathers a block's positions
-// from the groom-ordered float4 arrays, keeps it in L1 through every substep's stages
-// (references, integration, edge corrections, collisions) and writes the awake strands
-// back: a sleeping strand (core/sleep.h) is computed in its lane but never written.
+// so one vector instruction advances kLanes strands. A block's positions and previous
+// positions live in this layout across frames; the pass keeps the block in L1 through
+// every substep's stages (references, integration, edge corrections, collisions), then
+// writes the positions of the lanes asked for to the groom-ordered float4 array (the
+// HairModel interface).
 //
 // Every lane performs the same floating-point operations in the same order as the
 // per-strand kernels of strand_kernels.cpp and halen_kernels.cpp, with Eigen's evaluation
@@ -44,19 +45,23 @@ inline constexpr std::size_t block_floats(Model m, int n) {
   return m == Model::Spring ? static_cast<std::size_t>(kSpringFields * n) * kLanes
                             : static_cast<std::size_t>(kCascadeFields * n + kRootSpaceRows) * kLanes;
 }
-// Per-thread scratch for a block of n vertices: positions, previous positions and the
-// world-space reference nodes (one set for the spring model, up and down for the cascade).
-inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(12 * n) * kLanes; }
+// The state of a block, n rows of kLanes floats each, persistent across frames.
+enum StateField : int { PX, PY, PZ, QX, QY, QZ, kStateFields };  // positions, previous positions
+inline constexpr std::size_t state_floats(int n) { return static_cast<std::size_t>(kStateFields * n) * kLanes; }
+// Per-thread scratch for a block of n vertices: the world-space reference nodes (one set
+// for the spring model, up and down for the cascade).
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(6 * n) * kLanes; }
 
 // What a row (one vertex of every lane) holds: most rows are all free or all pinned.
 enum RowKind : std::uint8_t { kRowFree, kRowPinned, kRowMixed };
 
 struct Block {
   const float* data;              // block_floats(model, n) floats
+  float* state;                   // state_floats(n) floats
   int n;                          // vertices per strand
   const std::uint32_t* offset;    // per lane: the strand's first vertex in the float4 arrays
   const RowKind* rows;            // n entries
-  const std::uint8_t* write;      // per lane: 1 = write the lane back (awake, not a repeat)
+  const std::uint8_t* write;      // per lane: 1 = write its positions out (awake, not a repeat)
 };
 
 // Per-region settings of a block.
@@ -85,12 +90,12 @@ struct Frame {
 
 enum Stage : int { kReferences, kIntegrate, kLength, kCollision, kStageCount };
 
-// Advances one block by one frame: reads and writes the positions `pos` and the previous
-// positions `prev` (float4 per vertex, groom order) of the block's lanes that have
-// write[l] set. scratch holds scratch_floats(n) floats. With stage_ns non-null, adds the
-// nanoseconds spent in each Stage (callers pass it for a sample of blocks only).
-using FrameFn = void (*)(Model model, const Block& block, const BlockParams& params, const Frame& frame, float* pos,
-                         float* prev, float* scratch, std::int64_t* stage_ns);
+// Advances every lane of one block by one frame and writes the xyz of the lanes with
+// write[l] set to `out` (float4 per vertex, groom order). scratch holds scratch_floats(n)
+// floats. With stage_ns non-null, adds the nanoseconds spent in each Stage (callers pass
+// it for a sample of blocks only).
+using FrameFn = void (*)(Model model, const Block& block, const BlockParams& params, const Frame& frame, float* out,
+                         float* scratch, std::int64_t* stage_ns);
 
 // The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline
 // build. Both give the same bits.

@@ -169,7 +169,8 @@ void edge_length(const Rows& r) {
 }
 
 // Sphere collisions (collide_spheres): up to four passes; a pass that moves no lane of a
-// row ends it (a lane that did not move would not move in a further pass either).
+// row ends it (a lane that did not move would not move in a further pass either). The
+// push (a root and three divisions per lane) runs only for a sphere some lane is inside.
 void collide(const Rows& r, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < r.n; ++i) {
@@ -182,6 +183,14 @@ void collide(const Rows& r, const Substep& s) {
       for (int c = 0; c < s.sphere_count; ++c) {
         const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
                     rad = s.spheres[4 * c + 3];
+        int inside = 0;
+        LANES {
+          const float dx = px[l] - sx, dy = py[l] - sy, dz = pz[l] - sz;
+          const float dist2 = dx * dx + (dy * dy + dz * dz);
+          inside |= iw[l] != 0.0f && !(dist2 >= rad * rad);
+        }
+        if (!inside) continue;
+        moved = 1;
         LANES {
           const float dx = px[l] - sx, dy = py[l] - sy, dz = pz[l] - sz;
           const float dist2 = dx * dx + (dy * dy + dz * dz);
@@ -192,7 +201,6 @@ void collide(const Rows& r, const Substep& s) {
           px[l] = in ? sx + nx * rad : px[l];
           py[l] = in ? sy + ny * rad : py[l];
           pz[l] = in ? sz + nz * rad : pz[l];
-          moved |= in;
         }
       }
       if (!moved) break;
@@ -307,39 +315,26 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
 }
 
 template <Model kModel>
-void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* pos, float* prev, float* scratch,
+void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
                 std::int64_t* stage_ns) {
   const int n = b.n;
   const std::size_t rows = static_cast<std::size_t>(n) * W;
   Rows r{n,
+         b.state + PX * rows,
+         b.state + PY * rows,
+         b.state + PZ * rows,
+         b.state + QX * rows,
+         b.state + QY * rows,
+         b.state + QZ * rows,
          scratch,
          scratch + rows,
          scratch + 2 * rows,
          scratch + 3 * rows,
          scratch + 4 * rows,
          scratch + 5 * rows,
-         scratch + 6 * rows,
-         scratch + 7 * rows,
-         scratch + 8 * rows,
-         scratch + 9 * rows,
-         scratch + 10 * rows,
-         scratch + 11 * rows,
          b.data,
          b.rows};
   Clock clock(stage_ns);
-  for (int l = 0; l < W; ++l) {
-    const float* s = pos + static_cast<std::size_t>(b.offset[l]) * 4;
-    const float* q = prev + static_cast<std::size_t>(b.offset[l]) * 4;
-    for (int i = 0; i < n; ++i) {
-      r.px[i * W + l] = s[4 * i];
-      r.py[i * W + l] = s[4 * i + 1];
-      r.pz[i * W + l] = s[4 * i + 2];
-      r.qx[i * W + l] = q[4 * i];
-      r.qy[i * W + l] = q[4 * i + 1];
-      r.qz[i * W + l] = q[4 * i + 2];
-    }
-  }
-  clock.lap(kIntegrate);
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
     const Pose h(s);
@@ -372,26 +367,22 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* pos
   }
   for (int l = 0; l < W; ++l) {
     if (!b.write[l]) continue;
-    float* s = pos + static_cast<std::size_t>(b.offset[l]) * 4;
-    float* q = prev + static_cast<std::size_t>(b.offset[l]) * 4;
+    float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
     for (int i = 0; i < n; ++i) {
-      s[4 * i] = r.px[i * W + l];
-      s[4 * i + 1] = r.py[i * W + l];
-      s[4 * i + 2] = r.pz[i * W + l];
-      q[4 * i] = r.qx[i * W + l];
-      q[4 * i + 1] = r.qy[i * W + l];
-      q[4 * i + 2] = r.qz[i * W + l];
+      o[4 * i] = r.px[i * W + l];
+      o[4 * i + 1] = r.py[i * W + l];
+      o[4 * i + 2] = r.pz[i * W + l];
     }
   }
   clock.lap(kIntegrate);
 }
 
-void frame(Model model, const Block& b, const BlockParams& p, const Frame& f, float* pos, float* prev,
-           float* scratch, std::int64_t* stage_ns) {
+void frame(Model model, const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
+           std::int64_t* stage_ns) {
   if (model == Model::Spring)
-    frame_impl<Model::Spring>(b, p, f, pos, prev, scratch, stage_ns);
+    frame_impl<Model::Spring>(b, p, f, out, scratch, stage_ns);
   else
-    frame_impl<Model::Cascade>(b, p, f, pos, prev, scratch, stage_ns);
+    frame_impl<Model::Cascade>(b, p, f, out, scratch, stage_ns);
 }
 
 }  // namespace

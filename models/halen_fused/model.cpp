@@ -59,7 +59,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   });
   blocks_.clear();
   row_kinds_.clear();
-  std::size_t floats = 0;
+  std::size_t floats = 0, state_floats = 0;
   int max_n = 0;
   for (std::size_t i = 0; i < order.size();) {
     const std::uint16_t region = rest.strand_region[order[i]];
@@ -70,6 +70,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
       ++j;
     BlockInfo b;
     b.offset = floats;
+    b.state = state_floats;
     b.rows = row_kinds_.size();
     b.n = n;
     b.region = region;
@@ -86,11 +87,13 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
       row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
     }
     floats += soa::block_floats(model_, n);
+    state_floats += soa::state_floats(n);
     max_n = std::max(max_n, n);
     blocks_.push_back(b);
     i = j;
   }
   data_.assign(floats, 0.0f);
+  state_.assign(state_floats, 0.0f);
   for (const BlockInfo& b : blocks_) {
     float* d = data_.data() + b.offset;
     const std::size_t rows = static_cast<std::size_t>(b.n) * W;
@@ -99,6 +102,10 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
       for (int i = 0; i < b.n; ++i) {
         const std::size_t v = b.offset_of[l] + static_cast<std::size_t>(i);
         const Vec4f& p0 = rest.positions[v];
+        for (int c = 0; c < 3; ++c) {  // the hair starts at rest
+          state_[b.state + (soa::PX + c) * rows + static_cast<std::size_t>(i) * W + l] = p0[c];
+          state_[b.state + (soa::QX + c) * rows + static_cast<std::size_t>(i) * W + l] = p0[c];
+        }
         at(soa::RX, i, l) = p0.x();
         at(soa::RY, i, l) = p0.y();
         at(soa::RZ, i, l) = p0.z();
@@ -141,6 +148,9 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
   scratch_stride_ = soa::scratch_floats(max_n);
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
+  backup_stride_ = soa::state_floats(max_n);
+  backup_.assign(backup_stride_ * static_cast<std::size_t>(threads), 0.0f);
+  prev_tmp_.assign(static_cast<std::size_t>(max_n) * static_cast<std::size_t>(threads), Vec4f::Zero());
   write_.assign(blocks_.size() * W, 0);
   substep_.assign(static_cast<std::size_t>(substeps_), soa::Substep{});
   spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
@@ -152,52 +162,91 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
     strand_size_[s] = rest.strand_size(s);
   }
   pos_ = rest.positions;
-  prev_ = rest.positions;
   sleep_.reset(rest.strand_count());
 }
 
 std::size_t HalenFusedModel::state_bytes() const {
-  return data_.size() * sizeof(float) + (pos_.size() + prev_.size()) * sizeof(Vec4f);
+  return (data_.size() + state_.size()) * sizeof(float) + pos_.size() * sizeof(Vec4f);
+}
+
+// Asks for the next block's fields, state and output lines while this block computes: a block's
+// strands are a few hundred bytes each, spread over the groom, too little for the
+// hardware prefetchers to ramp up.
+void HalenFusedModel::prefetch(const BlockInfo& b) const {
+  constexpr std::size_t kLine = 64;
+  const char* d = reinterpret_cast<const char*>(data_.data() + b.offset);
+  const std::size_t bytes = soa::block_floats(model_, b.n) * sizeof(float);
+  for (std::size_t o = 0; o < bytes; o += kLine) __builtin_prefetch(d + o, 0, 3);
+  const char* st = reinterpret_cast<const char*>(state_.data() + b.state);
+  for (std::size_t o = 0; o < soa::state_floats(b.n) * sizeof(float); o += kLine) __builtin_prefetch(st + o, 1, 3);
+  for (int l = 0; l < W; ++l) {
+    if (b.strand[l] == kNoStrand) continue;
+    const char* p = reinterpret_cast<const char*>(pos_.data() + b.offset_of[l]);
+    for (std::size_t o = 0; o < b.n * sizeof(Vec4f); o += kLine) __builtin_prefetch(p + o, 1, 3);
+  }
 }
 
 void HalenFusedModel::run_thread(int t) {
   ThreadState& ts = threads_[static_cast<std::size_t>(t)];
   float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
-  float* pos = pos_.data()->data();
-  float* prev = prev_.data()->data();
+  float* backup = backup_.data() + backup_stride_ * static_cast<std::size_t>(t);
+  float* out = pos_.data()->data();
   for (std::size_t i = ts.first; i < ts.last; ++i) {
     const BlockInfo& b = blocks_[i];
     std::uint8_t* write = write_.data() + i * W;
-    int awake = 0;
+    int awake = 0, asleep = 0;
     for (int l = 0; l < W; ++l) {
-      write[l] = b.strand[l] != kNoStrand && !(calm_ && sleep_.asleep(b.strand[l]));
+      const bool real = b.strand[l] != kNoStrand;
+      const bool sleeps = real && calm_ && sleep_.asleep(b.strand[l]);
+      write[l] = real && !sleeps;
       awake += write[l];
+      asleep += sleeps;
     }
     if (awake == 0) continue;  // every strand of the block sleeps
+    if (i + 1 < ts.last) prefetch(blocks_[i + 1]);
+    float* state = state_.data() + b.state;
+    const std::size_t state_floats = soa::state_floats(b.n);
+    if (asleep > 0) std::copy_n(state, state_floats, backup);
     const Region& r = region_[b.region];
     const soa::BlockParams p{r.keep, r.length_iterations,
                              spring_scale_.data() + static_cast<std::size_t>(b.region) * substep_.size()};
-    const soa::Block block{data_.data() + b.offset, b.n, b.offset_of.data(), row_kinds_.data() + b.rows, write};
+    const soa::Block block{data_.data() + b.offset, state, b.n, b.offset_of.data(), row_kinds_.data() + b.rows, write};
     if (!b.sampled) {
-      kernel_(model_, block, p, frame_, pos, prev, scratch, nullptr);
+      kernel_(model_, block, p, frame_, out, scratch, nullptr);
     } else {
       const auto start = std::chrono::steady_clock::now();
-      kernel_(model_, block, p, frame_, pos, prev, scratch, ts.stage_ns.data());
+      kernel_(model_, block, p, frame_, out, scratch, ts.stage_ns.data());
       ts.sampled_ns +=
           std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
     }
+    if (asleep == 0) continue;
+    // A sleeping strand is not touched (issue 8): its lane's state is put back.
+    for (int l = 0; l < W; ++l)
+      if (b.strand[l] != kNoStrand && !write[l])
+        for (std::size_t k = static_cast<std::size_t>(l); k < state_floats; k += W) state[k] = backup[k];
   }
 }
 
-// StrandSleep::observe for every awake strand of this thread's blocks.
+// StrandSleep::observe for every awake strand of this thread's blocks, with the previous
+// positions gathered from the block (the last substep's, as the reference's prev).
 void HalenFusedModel::observe_sleep(int t, float dt) {
   const ThreadState& ts = threads_[static_cast<std::size_t>(t)];
-  for (std::size_t i = ts.first; i < ts.last; ++i)
-    for (std::uint32_t s : blocks_[i].strand) {
+  Vec4f* prev = prev_tmp_.data() + prev_tmp_.size() / threads_.size() * static_cast<std::size_t>(t);
+  for (std::size_t i = ts.first; i < ts.last; ++i) {
+    const BlockInfo& b = blocks_[i];
+    const float* st = state_.data() + b.state;
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    for (int l = 0; l < W; ++l) {
+      const std::uint32_t s = b.strand[l];
       if (s == kNoStrand || sleep_.asleep(s)) continue;
-      sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(strand_begin_[s], strand_size_[s]),
-                     std::span<const Vec4f>(prev_).subspan(strand_begin_[s], strand_size_[s]), dt);
+      for (int v = 0; v < b.n; ++v) {
+        const std::size_t k = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(l);
+        prev[v] = Vec4f(st[soa::QX * rows + k], st[soa::QY * rows + k], st[soa::QZ * rows + k], 0.0f);
+      }
+      const std::size_t n = static_cast<std::size_t>(b.n);
+      sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(strand_begin_[s], n), std::span<const Vec4f>(prev, n), dt);
     }
+  }
 }
 
 void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {

@@ -24,7 +24,7 @@ class HalenFusedModel final : public HairModel {
   void reset(const Groom& rest, const ParamSet& params) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
-  // The blocks' fields and the positions and previous positions.
+  // The blocks' fields and state, and the positions written out.
   std::size_t state_bytes() const override;
   // Replaces the run-time chosen kernel variant (tests compare the variants).
   void use_kernel(kernels::halen_soa::FrameFn fn) { kernel_ = fn; }
@@ -37,6 +37,7 @@ class HalenFusedModel final : public HairModel {
   };
   struct BlockInfo {
     std::size_t offset = 0;     // into data_
+    std::size_t state = 0;      // into state_
     std::size_t rows = 0;       // into row_kinds_
     int n = 0;
     std::uint16_t region = 0;
@@ -50,6 +51,7 @@ class HalenFusedModel final : public HairModel {
     std::int64_t sampled_ns = 0;
   };
   static constexpr std::uint32_t kNoStrand = 0xffffffffu;
+  void prefetch(const BlockInfo& b) const;
   void run_thread(int t);
   void observe_sleep(int t, float dt);
 
@@ -60,11 +62,15 @@ class HalenFusedModel final : public HairModel {
   int substeps_ = 1;
   std::vector<BlockInfo> blocks_;
   std::vector<float> data_;
+  std::vector<float> state_;  // positions and previous positions, block by block
   std::vector<kernels::halen_soa::RowKind> row_kinds_;
   std::vector<std::uint8_t> write_;  // per block and lane, refreshed every step
   std::vector<ThreadState> threads_;
   std::vector<float> scratch_;
   std::size_t scratch_stride_ = 0;
+  std::vector<float> backup_;  // per thread: a block's state, for its sleeping lanes
+  std::size_t backup_stride_ = 0;
+  std::vector<Vec4f> prev_tmp_;  // per thread: one strand's previous positions
   std::vector<kernels::halen_soa::Substep> substep_;
   std::vector<float> spheres_;        // per substep, x y z r per collider
   std::vector<float> spring_scale_;   // per region and substep: §4.4's tilt factor
@@ -72,7 +78,7 @@ class HalenFusedModel final : public HairModel {
   bool calm_ = false;
   StrandSleep sleep_;
   std::vector<std::uint32_t> strand_begin_, strand_size_;
-  std::vector<Vec4f> pos_, prev_;
+  std::vector<Vec4f> pos_;
 };
 
 std::unique_ptr<HairModel> make(Model model, const ModelContext& ctx);
