@@ -1,9 +1,10 @@
-// The fused structure-of-arrays Halén & Wester models (halen_spring, halen_cascade;
-// models/halen_fused) against the per-stage reference implementations (halen_*_ref):
-// the fused kernel performs every strand's floating-point operations in the reference's
-// order, so the states must agree bit for bit, frame after frame, on equal and ragged
-// grooms, with and without wind and colliders, through sleep and wake; and the state must
-// not depend on the thread count or on the ISA variant of the kernel.
+// The fast Halén & Wester models against the per-stage reference implementations
+// (halen_*_ref): the structure-of-arrays kernel of halen_spring and halen_cascade
+// (models/halen_fused) and halen_forest's per-strand schedule perform every strand's
+// floating-point operations in the reference's order, so the states must agree bit for
+// bit, frame after frame, on equal and ragged grooms, with and without wind and
+// colliders, through sleep and wake; and the state must not depend on the thread count or
+// on the ISA variant of the kernel.
 #include "test_support.h"
 
 #include "core/parallel.h"
@@ -56,11 +57,12 @@ int first_difference(const Scenario& sc, const std::string& a, const std::string
   return first;
 }
 
+const std::vector<std::string> kFast = {"halen_spring", "halen_cascade", "halen_forest"};
 const std::vector<std::string> kFused = {"halen_spring", "halen_cascade"};
 
 TEST(HalenFused, BitIdenticalToReferenceOnShake) {
   const Scenario sc = test::builtin("shake", 8);
-  for (const std::string& m : kFused) {
+  for (const std::string& m : kFast) {
     double diff = 0.0;
     EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}, &diff), -1) << m << " max diff " << diff;
   }
@@ -68,13 +70,13 @@ TEST(HalenFused, BitIdenticalToReferenceOnShake) {
 
 TEST(HalenFused, BitIdenticalToReferenceInWind) {
   const Scenario sc = test::builtin("wind_gust", 16);
-  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
+  for (const std::string& m : kFast) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
 }
 
 // §4.4's tilt weakening changes the spring scale every substep.
 TEST(HalenFused, BitIdenticalToReferenceUpsideDown) {
   const Scenario sc = test::builtin("tilt_upside_down", 16);
-  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
+  for (const std::string& m : kFast) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
 }
 
 // The Table 1 model-1 groom: three regions, ragged vertex counts (partly filled blocks),
@@ -84,7 +86,7 @@ TEST(HalenFused, BitIdenticalToReferenceOnRaggedPaperGroom) {
   std::set<std::uint32_t> sizes;
   for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) sizes.insert(sc.groom.strand_size(s));
   ASSERT_GT(sizes.size(), 1u) << "the groom should be ragged";
-  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, {}), -1) << m;
+  for (const std::string& m : kFast) EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, {}), -1) << m;
 }
 
 // Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
@@ -98,13 +100,13 @@ TEST(HalenFused, BitIdenticalToReferenceThroughSleepAndWake) {
   turn.start = 2.0;
   turn.end = 10.0;
   sc.head.oscillators = {turn};
-  for (const std::string& m : kFused) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
+  for (const std::string& m : kFast) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
 }
 
 // --no-skip (ModelContext::skip_inert off): every stage and term runs, nothing sleeps.
 TEST(HalenFused, BitIdenticalToReferenceWithoutSkipping) {
   const Scenario sc = test::builtin("idle", 16);
-  for (const std::string& m : kFused)
+  for (const std::string& m : kFast)
     EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}, nullptr, false), -1) << m;
 }
 
@@ -120,7 +122,7 @@ std::uint64_t state_hash_after(const Scenario& sc, const std::string& model, int
 
 TEST(HalenFused, StateHashIndependentOfThreadCount) {
   const Scenario sc = paper_model1(8);
-  for (const std::string& m : kFused) {
+  for (const std::string& m : kFast) {
     const auto one = state_hash_after(sc, m, 1, 20);
     EXPECT_EQ(one, state_hash_after(sc, m, 2, 20)) << m;
     EXPECT_EQ(one, state_hash_after(sc, m, 3, 20)) << m;
@@ -146,7 +148,7 @@ TEST(HalenFused, IsaVariantsGiveTheSameBits) {
   }
 }
 
-// The stages of the reference are reported, collisions skipped without colliders.
+// The stages of the references are reported, collisions skipped without colliders.
 TEST(HalenFused, StagesAreReported) {
   const Scenario sc = test::builtin("shake", 16);
   ThreadPool pool(2);
@@ -162,6 +164,12 @@ TEST(HalenFused, StagesAreReported) {
                            {"references", false}, {"integrate", false}, {"length", false}, {"collision", true}}))
         << name;
   }
+  auto forest = make("halen_forest", sc, {}, pool);
+  StageTimes t;
+  forest->step(frame_input(sc, 0), t);
+  std::map<std::string, bool> skipped;
+  for (const auto& e : t.entries()) skipped[std::string(e.name)] = e.skipped;
+  EXPECT_EQ(skipped, (std::map<std::string, bool>{{"pose", false}, {"integrate", false}}));
 }
 
 }  // namespace
