@@ -189,6 +189,24 @@ void forest_rest(std::span<const Vec4f> rest, ForestAxes axes, std::span<Mat3f> 
   }
 }
 
+float forest_setup(std::span<const Vec4f> rest, ForestAxes axes, float stiffness, float c, int exponent,
+                   std::span<Mat3f> rest_frame, std::span<float> theta0, std::span<float> phi0,
+                   std::span<float> length, std::span<float> k) {
+  const std::size_t n = rest.size();
+  forest_rest(rest, axes, rest_frame, theta0, phi0, length);
+  std::vector<float> arc(n);
+  arc_lengths(rest, arc);
+  k[0] = 0.0f;
+  // The joint of segment i sits at vertex i-1.
+  for (std::size_t i = 1; i < n; ++i) k[i] = falloff_stiffness(stiffness, arc[i - 1], c, exponent);
+  return 1.0f / arc[n - 1];
+}
+
+Mat34f root_inertia(const Affine3f& head, const Affine3f& h1, const Affine3f& h0, float dt) {
+  const Eigen::Matrix4f second = head.matrix() - 2.0f * h1.matrix() + h0.matrix();
+  return (second * head.inverse(Eigen::Isometry).matrix()).topRows<3>() / (dt * dt);
+}
+
 void forest_pose(const ForestStrand& s, ForestAxes axes, const Affine3f& head) {
   const Mat3f head_rotation = head.linear();
   const std::size_t n = s.pos.size();

@@ -110,6 +110,18 @@ struct ForestStrand {
   std::span<Vec4f> pos;
 };
 
+// The set-up of one strand (§4.2, §5.9): forest_rest, and the joint stiffness falling with
+// the distance of the joint (vertex i-1 for segment i) from the root. Returns 1/ℓ, ℓ the
+// strand's length (see forest_integrate).
+float forest_setup(std::span<const Vec4f> rest, ForestAxes axes, float stiffness, float c, int exponent,
+                   std::span<Mat3f> rest_frame, std::span<float> theta0, std::span<float> phi0,
+                   std::span<float> length, std::span<float> k);
+
+// The acceleration of a point rigid with the head, a(p) = inertia · (p, 1), by central
+// differences of the head transform over three substeps dt apart (h0, h1, head):
+// (H - 2H_1 + H_0) H^-1 p / dt².
+Mat34f root_inertia(const Affine3f& head, const Affine3f& h1, const Affine3f& h0, float dt);
+
 // Rest angles and frames of one strand (head at identity), from its rest polyline.
 void forest_rest(std::span<const Vec4f> rest, ForestAxes axes, std::span<Mat3f> rest_frame,
                  std::span<float> theta0, std::span<float> phi0, std::span<float> length);

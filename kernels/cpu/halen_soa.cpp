@@ -5,25 +5,45 @@ namespace hairbench::kernels::halen_soa {
 
 namespace baseline {
 FrameFn frame_fn();
-}
+ForestFrameFn forest_frame_fn();
+}  // namespace baseline
 #ifdef HAIRBENCH_HALEN_SOA_V4
 namespace x86_64_v4 {
 FrameFn frame_fn();
-}
+ForestFrameFn forest_frame_fn();
+}  // namespace x86_64_v4
 #endif
 
+namespace {
+bool has_v4() {
+#ifdef HAIRBENCH_HALEN_SOA_V4
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+         __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+#else
+  return false;
+#endif
+}
+}  // namespace
+
 FrameFn frame_kernel_baseline() { return baseline::frame_fn(); }
+ForestFrameFn forest_kernel_baseline() { return baseline::forest_frame_fn(); }
 
 FrameFn frame_kernel() {
 #ifdef HAIRBENCH_HALEN_SOA_V4
-  __builtin_cpu_init();
-  static const FrameFn fn = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-                                    __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl")
-                                ? x86_64_v4::frame_fn()
-                                : baseline::frame_fn();
+  static const FrameFn fn = has_v4() ? x86_64_v4::frame_fn() : baseline::frame_fn();
   return fn;
 #else
   return baseline::frame_fn();
+#endif
+}
+
+ForestFrameFn forest_kernel() {
+#ifdef HAIRBENCH_HALEN_SOA_V4
+  static const ForestFrameFn fn = has_v4() ? x86_64_v4::forest_frame_fn() : baseline::forest_frame_fn();
+  return fn;
+#else
+  return baseline::forest_frame_fn();
 #endif
 }
 

@@ -23,7 +23,7 @@ namespace hairbench::kernels::halen_soa {
 
 inline constexpr int kLanes = 16;
 
-enum class Model : int { Spring, Cascade };
+enum class Model : int { Spring, Cascade, Forest };
 
 // Read-only fields of a block, each n rows of kLanes floats.
 enum Field : int {
@@ -90,6 +90,60 @@ struct Frame {
 
 enum Stage : int { kReferences, kIntegrate, kLength, kCollision, kStageCount };
 
+// ---- the interactive forest (§4.2, §5.9) ---------------------------------------------
+//
+// The same blocks for halen_forest, with its own fields. Unlike the spring models, the
+// forest's lanes do not repeat the per-strand kernels' operations bit for bit: the joint
+// rotation R_primary(θ) R_y(φ) is written in closed form and sin/cos are a vectorisable
+// polynomial (kernels/cpu/vec_math.h), so the kernel agrees with halen_forest_ref to rounding
+// (tests/halen_fused_test.cpp bounds the difference).
+enum ForestField : int {
+  FRX, FRY, FRZ,  // rest positions in the head's rest frame
+  FIW,            // inverse mass (0 = pinned: the segment ending here is rigid with the head)
+  FLEN,           // segment length L_i
+  FTH0, FPH0,     // rest angles
+  FK,             // joint stiffness per unit inertia
+  FR0, FR1, FR2, FR3, FR4, FR5, FR6, FR7, FR8,  // rest frame (head at identity), column by column
+  kForestFields
+};
+// A lane's 1/ℓ (forest_integrate), one row after the fields.
+inline constexpr std::size_t forest_block_floats(int n) {
+  return static_cast<std::size_t>(kForestFields * n + 1) * kLanes;
+}
+enum ForestState : int { TH, PH, DTH, DPH, kForestStateFields };  // joint angles and their rates
+inline constexpr std::size_t forest_state_floats(int n) {
+  return static_cast<std::size_t>(kForestStateFields * n) * kLanes;
+}
+// Scratch: every vertex's frame, position and joint torque.
+inline constexpr std::size_t forest_scratch_floats(int n) { return static_cast<std::size_t>(15 * n) * kLanes; }
+
+struct ForestSubstep {
+  float m[9];        // head linear part, row-major
+  float t[3];        // head translation
+  float inertia[12]; // a(p) = inertia · (p, 1), row-major 3x4
+  const float* spheres;  // world-space x, y, z, r
+  int sphere_count;
+};
+struct ForestFrame {
+  const ForestSubstep* substeps;  // substep_count, then the frame's final head pose
+  int substep_count;
+  float gravity[3];
+  float wind[3];
+  bool windy;
+  bool parent_x;  // ForestAxes::ParentX (else ParentZ)
+  float dt;
+};
+struct ForestParams {
+  float joint_damping;
+  float collision_stiffness;
+};
+using ForestFrameFn = void (*)(const Block& block, const ForestParams& params, const ForestFrame& frame, float* out,
+                               float* scratch, std::int64_t* stage_ns);
+ForestFrameFn forest_kernel();
+ForestFrameFn forest_kernel_baseline();
+// Stages of the forest kernel's stage_ns.
+enum ForestStage : int { kPose, kForestIntegrate, kForestStageCount };
+
 // Advances every lane of one block by one frame and writes the xyz of the lanes with
 // write[l] set to `out` (float4 per vertex, groom order). scratch holds scratch_floats(n)
 // floats. With stage_ns non-null, adds the nanoseconds spent in each Stage (callers pass
@@ -98,7 +152,7 @@ using FrameFn = void (*)(Model model, const Block& block, const BlockParams& par
                          float* scratch, std::int64_t* stage_ns);
 
 // The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline
-// build. Both give the same bits.
+// build. Both give the same bits (the forest's too: its polynomial is the same code).
 FrameFn frame_kernel();
 // The baseline variant, for the tests that compare ISA variants.
 FrameFn frame_kernel_baseline();

@@ -7,12 +7,6 @@
 // stiffness falls with the distance from the root. The forest's counterpart of the other
 // two models' L = mg/k: gravity's torque on the head-transformed rest segments is
 // subtracted, so the head-transformed rest pose is in equilibrium.
-//
-// Two schedules of the same per-strand kernels, bit-identical: Schedule::PerStage (the
-// reference, halen_forest_ref) runs each stage over all strands, substep by substep;
-// Schedule::PerStrand (halen_forest) runs every substep of one strand before the next
-// strand, so the strand's joints stay in L1 through the frame, with the head poses and
-// forces of all substeps computed once per step.
 #pragma once
 
 #include "core/hair_model.h"
@@ -24,11 +18,9 @@
 
 namespace hairbench::halen_forest {
 
-enum class Schedule { PerStage, PerStrand };
-
 class ForestModel final : public HairModel {
  public:
-  ForestModel(Schedule schedule, const ModelContext& ctx);
+  explicit ForestModel(const ModelContext& ctx);
   void reset(const Groom& rest, const ParamSet& params) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
@@ -37,17 +29,10 @@ class ForestModel final : public HairModel {
 
  private:
   void pose(const Affine3f& head);
-  void step_per_stage(const FrameInput& in, float dt, StageTimes& times);
-  void step_per_strand(const FrameInput& in, float dt, StageTimes& times);
-  kernels::ForestForces substep_forces(const FrameInput& in, const Affine3f& head, float dt,
-                                       std::span<Vec4f> spheres);
-  kernels::ForestForces strand_forces(const kernels::ForestForces& f, std::size_t s) const;
-  void run_strands(int t);
   kernels::ForestStrand strand_view(std::size_t s);
   template <class F>
   void for_each_strand(F&& f);
 
-  Schedule schedule_;
   ModelContext ctx_;
   Groom rest_;
   kernels::ForestAxes axes_ = kernels::ForestAxes::ParentX;
@@ -61,16 +46,9 @@ class ForestModel final : public HairModel {
   Affine3f head_hist_[2];  // head transforms of the last two substeps (the root's inertia)
   std::vector<Vec4f> pos_;
   std::vector<Vec4f> spheres_;
-  // PerStrand: each substep's head pose and forces, and the frame's final head pose.
-  std::vector<Affine3f> heads_;
-  std::vector<kernels::ForestForces> forces_;
-  struct ThreadTimes {
-    std::int64_t pose_ns = 0, integrate_ns = 0, sampled_ns = 0;
-  };
-  std::vector<ThreadTimes> thread_times_;
   StrandSleep sleep_;
 };
 
-std::unique_ptr<HairModel> make(Schedule schedule, const ModelContext& ctx);
+std::unique_ptr<HairModel> make(const ModelContext& ctx);
 
 }  // namespace hairbench::halen_forest

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 
 namespace hairbench::halen_fused {
@@ -16,37 +17,31 @@ namespace k = hairbench::kernels;
 constexpr std::size_t kSampleEvery = 16;
 
 HalenFusedModel::HalenFusedModel(Model model, const ModelContext& ctx)
-    : model_(model), ctx_(ctx), kernel_(soa::frame_kernel()) {}
+    : model_(model), ctx_(ctx), kernel_(soa::frame_kernel()), forest_kernel_(soa::forest_kernel()) {}
+
+std::size_t HalenFusedModel::block_floats(int n) const {
+  return model_ == Model::Forest ? soa::forest_block_floats(n) : soa::block_floats(model_, n);
+}
+std::size_t HalenFusedModel::state_floats(int n) const {
+  return model_ == Model::Forest ? soa::forest_state_floats(n) : soa::state_floats(n);
+}
 
 void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
-  const bool spring = model_ == Model::Spring;
+  const bool forest = model_ == Model::Forest;
   region_.clear();
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r)
-    region_.push_back({1.0f - static_cast<float>(params.get("damping", r)),
-                       spring ? static_cast<float>(params.get("tilt_min", r)) : 1.0f,
-                       params.get_int("length_iterations", r)});
-  substeps_ = params.get_int("substeps");
-
-  // Per-vertex constants, with the set-up the reference models use.
-  const std::size_t nv = rest.vertex_count();
-  const std::vector<float> rest_length = rest_edge_lengths(rest);
-  std::vector<float> k_up(nv), k_down(nv), lift(nv);
-  std::vector<k::Mat3f> rest_space(spring ? 0 : nv);
-  std::vector<Vec3f> up_local(spring ? 0 : nv), down_local(spring ? 0 : nv);
-  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
-    const auto strand_rest = std::span(rest.positions).subspan(b, n);
-    const float stiffness = static_cast<float>(params.get("stiffness", r));
-    const float c = static_cast<float>(params.get("falloff_scale", r));
-    const int a = params.get_int("falloff_exponent", r);
-    if (spring)
-      k::spring_setup(strand_rest, stiffness, c, a, std::span(k_up).subspan(b, n), std::span(lift).subspan(b, n));
-    else
-      k::cascade_setup(strand_rest, stiffness, c, a, static_cast<float>(params.get("down_fraction", r)),
-                       std::span(k_up).subspan(b, n), std::span(k_down).subspan(b, n),
-                       std::span(rest_space).subspan(b, n), std::span(up_local).subspan(b, n),
-                       std::span(down_local).subspan(b, n), std::span(lift).subspan(b, n));
+  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
+    Region g{1.0f, 1.0f, 0, {}};
+    if (forest) {
+      g.forest = {static_cast<float>(params.get("joint_damping", r)),
+                  static_cast<float>(params.get("collision_stiffness", r))};
+    } else {
+      g.keep = 1.0f - static_cast<float>(params.get("damping", r));
+      g.length_iterations = params.get_int("length_iterations", r);
+      if (model_ == Model::Spring) g.tilt_min = static_cast<float>(params.get("tilt_min", r));
+    }
+    region_.push_back(g);
   }
+  substeps_ = params.get_int("substeps");
 
   // Blocks: strands of one region and one vertex count, W at a time (ragged grooms give
   // one partly filled block per (region, count); its idle lanes repeat a strand of the
@@ -59,7 +54,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   });
   blocks_.clear();
   row_kinds_.clear();
-  std::size_t floats = 0, state_floats = 0;
+  std::size_t floats = 0, state = 0;
   int max_n = 0;
   for (std::size_t i = 0; i < order.size();) {
     const std::uint16_t region = rest.strand_region[order[i]];
@@ -70,7 +65,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
       ++j;
     BlockInfo b;
     b.offset = floats;
-    b.state = state_floats;
+    b.state = state;
     b.rows = row_kinds_.size();
     b.n = n;
     b.region = region;
@@ -80,52 +75,22 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
       const std::uint32_t s = order[used ? i + l : j - 1];
       b.offset_of[l] = rest.strand_begin(s);
       b.strand[l] = used ? s : kNoStrand;
+      b.source[l] = s;
     }
     for (int v = 0; v < n; ++v) {
       int pinned = 0;
       for (int l = 0; l < W; ++l) pinned += rest.positions[b.offset_of[l] + v].w() == 0.0f;
       row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
     }
-    floats += soa::block_floats(model_, n);
-    state_floats += soa::state_floats(n);
+    floats += block_floats(n);
+    state += state_floats(n);
     max_n = std::max(max_n, n);
     blocks_.push_back(b);
     i = j;
   }
   data_.assign(floats, 0.0f);
-  state_.assign(state_floats, 0.0f);
-  for (const BlockInfo& b : blocks_) {
-    float* d = data_.data() + b.offset;
-    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
-    auto at = [&](int field, int i, int l) -> float& { return d[field * rows + static_cast<std::size_t>(i) * W + l]; };
-    for (int l = 0; l < W; ++l)
-      for (int i = 0; i < b.n; ++i) {
-        const std::size_t v = b.offset_of[l] + static_cast<std::size_t>(i);
-        const Vec4f& p0 = rest.positions[v];
-        for (int c = 0; c < 3; ++c) {  // the hair starts at rest
-          state_[b.state + (soa::PX + c) * rows + static_cast<std::size_t>(i) * W + l] = p0[c];
-          state_[b.state + (soa::QX + c) * rows + static_cast<std::size_t>(i) * W + l] = p0[c];
-        }
-        at(soa::RX, i, l) = p0.x();
-        at(soa::RY, i, l) = p0.y();
-        at(soa::RZ, i, l) = p0.z();
-        at(soa::IW, i, l) = p0.w();
-        at(soa::RL, i, l) = rest_length[v];
-        at(soa::LIFT, i, l) = lift[v];
-        at(soa::KU, i, l) = k_up[v];
-        if (spring) continue;
-        at(soa::KD, i, l) = k_down[v];
-        for (int c = 0; c < 3; ++c) {
-          at(soa::UX + c, i, l) = up_local[v][c];
-          at(soa::DX + c, i, l) = down_local[v][c];
-        }
-        if (i == 1) {  // the root segment's rest space, column by column
-          float* root = d + static_cast<std::size_t>(soa::kCascadeFields) * rows;
-          for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 3; ++r) root[(3 * c + r) * W + l] = rest_space[v](r, c);
-        }
-      }
-  }
+  state_.assign(state, 0.0f);
+  setup_blocks(rest, params);
 
   // Static partition of the blocks over the threads by estimated cost (vertices times
   // passes over them), fixed at reset: which thread runs a block never changes a bit of
@@ -146,13 +111,15 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
     while (next < blocks_.size() && (t == threads - 1 || acc + 0.5 * cost[next] < end)) acc += cost[next++];
     threads_[t].last = next;
   }
-  scratch_stride_ = soa::scratch_floats(max_n);
+  scratch_stride_ = forest ? soa::forest_scratch_floats(max_n) : soa::scratch_floats(max_n);
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
-  backup_stride_ = soa::state_floats(max_n);
+  backup_stride_ = state_floats(max_n);
   backup_.assign(backup_stride_ * static_cast<std::size_t>(threads), 0.0f);
   prev_tmp_.assign(static_cast<std::size_t>(max_n) * static_cast<std::size_t>(threads), Vec4f::Zero());
   write_.assign(blocks_.size() * W, 0);
   substep_.assign(static_cast<std::size_t>(substeps_), soa::Substep{});
+  forest_substep_.assign(static_cast<std::size_t>(substeps_) + 1, soa::ForestSubstep{});
+  head_hist_[0] = head_hist_[1] = Affine3f::Identity();
   spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
   spring_scale_.assign(region_.size() * static_cast<std::size_t>(substeps_), 1.0f);
   strand_begin_.resize(rest.strand_count());
@@ -163,6 +130,86 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
   pos_ = rest.positions;
   sleep_.reset(rest.strand_count());
+}
+
+// Fills every block's fields and initial state (the hair at rest), with the per-strand
+// set-up the reference models use.
+void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
+  const std::size_t nv = rest.vertex_count();
+  const bool spring = model_ == Model::Spring, forest = model_ == Model::Forest;
+  const std::vector<float> rest_length = rest_edge_lengths(rest);
+  std::vector<float> k_up(nv), k_down(nv), lift(nv), theta0(nv), phi0(nv), length(nv);
+  std::vector<k::Mat3f> space(spring ? 0 : nv);  // cascade: rest tangent spaces; forest: rest frames
+  std::vector<Vec3f> up_local(spring ? 0 : nv), down_local(spring ? 0 : nv);
+  const auto axes = forest && params.get_int("axis_convention") == 0 ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
+  forest_frame_.parent_x = axes == k::ForestAxes::ParentX;
+  inv_length_.assign(rest.strand_count(), 0.0f);
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
+    const auto strand_rest = std::span(rest.positions).subspan(b, n);
+    const float c = static_cast<float>(params.get("falloff_scale", r));
+    const int a = params.get_int("falloff_exponent", r);
+    auto at = [&](auto& v) { return std::span(v).subspan(b, n); };
+    if (spring)
+      k::spring_setup(strand_rest, static_cast<float>(params.get("stiffness", r)), c, a, at(k_up), at(lift));
+    else if (!forest)
+      k::cascade_setup(strand_rest, static_cast<float>(params.get("stiffness", r)), c, a,
+                       static_cast<float>(params.get("down_fraction", r)), at(k_up), at(k_down), at(space),
+                       at(up_local), at(down_local), at(lift));
+    else
+      inv_length_[s] = k::forest_setup(strand_rest, axes, static_cast<float>(params.get("joint_stiffness", r)), c, a,
+                                       at(space), at(theta0), at(phi0), at(length), at(k_up));
+  }
+  for (const BlockInfo& b : blocks_) {
+    float* d = data_.data() + b.offset;
+    float* st = state_.data() + b.state;
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    auto row = [&](float* base, int field, int i, int l) -> float& {
+      return base[field * rows + static_cast<std::size_t>(i) * W + static_cast<std::size_t>(l)];
+    };
+    for (int l = 0; l < W; ++l) {
+      if (forest) d[static_cast<std::size_t>(soa::kForestFields) * rows + l] = inv_length_[b.source[l]];
+      for (int i = 0; i < b.n; ++i) {
+        const std::size_t v = b.offset_of[l] + static_cast<std::size_t>(i);
+        const Vec4f& p0 = rest.positions[v];
+        if (forest) {
+          for (int c = 0; c < 3; ++c) row(d, soa::FRX + c, i, l) = p0[c];
+          row(d, soa::FIW, i, l) = p0.w();
+          row(d, soa::FLEN, i, l) = length[v];
+          row(d, soa::FTH0, i, l) = theta0[v];
+          row(d, soa::FPH0, i, l) = phi0[v];
+          row(d, soa::FK, i, l) = k_up[v];
+          for (int c = 0; c < 3; ++c)
+            for (int e = 0; e < 3; ++e) row(d, soa::FR0 + 3 * c + e, i, l) = space[v](e, c);
+          row(st, soa::TH, i, l) = theta0[v];
+          row(st, soa::PH, i, l) = phi0[v];
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) {  // the hair starts at rest
+          row(st, soa::PX + c, i, l) = p0[c];
+          row(st, soa::QX + c, i, l) = p0[c];
+        }
+        row(d, soa::RX, i, l) = p0.x();
+        row(d, soa::RY, i, l) = p0.y();
+        row(d, soa::RZ, i, l) = p0.z();
+        row(d, soa::IW, i, l) = p0.w();
+        row(d, soa::RL, i, l) = rest_length[v];
+        row(d, soa::LIFT, i, l) = lift[v];
+        row(d, soa::KU, i, l) = k_up[v];
+        if (spring) continue;
+        row(d, soa::KD, i, l) = k_down[v];
+        for (int c = 0; c < 3; ++c) {
+          row(d, soa::UX + c, i, l) = up_local[v][c];
+          row(d, soa::DX + c, i, l) = down_local[v][c];
+        }
+        if (i == 1) {  // the root segment's rest space, column by column
+          float* root = d + static_cast<std::size_t>(soa::kCascadeFields) * rows;
+          for (int c = 0; c < 3; ++c)
+            for (int e = 0; e < 3; ++e) root[(3 * c + e) * W + l] = space[v](e, c);
+        }
+      }
+    }
+  }
 }
 
 std::size_t HalenFusedModel::state_bytes() const {
@@ -211,14 +258,15 @@ void HalenFusedModel::run_thread(int t) {
     const soa::BlockParams p{r.keep, r.length_iterations,
                              spring_scale_.data() + static_cast<std::size_t>(b.region) * substep_.size()};
     const soa::Block block{data_.data() + b.offset, state, b.n, b.offset_of.data(), row_kinds_.data() + b.rows, write};
-    if (!b.sampled) {
-      kernel_(model_, block, p, frame_, out, scratch, nullptr);
-    } else {
-      const auto start = std::chrono::steady_clock::now();
-      kernel_(model_, block, p, frame_, out, scratch, ts.stage_ns.data());
+    std::int64_t* stage_ns = b.sampled ? ts.stage_ns.data() : nullptr;
+    const auto start = std::chrono::steady_clock::now();
+    if (model_ == Model::Forest)
+      forest_kernel_(block, r.forest, forest_frame_, out, scratch, stage_ns);
+    else
+      kernel_(model_, block, p, frame_, out, scratch, stage_ns);
+    if (b.sampled)
       ts.sampled_ns +=
           std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
-    }
     if (asleep == 0) continue;
     // A sleeping strand is not touched (issue 8): its lane's state is put back.
     for (int l = 0; l < W; ++l)
@@ -228,7 +276,8 @@ void HalenFusedModel::run_thread(int t) {
 }
 
 // StrandSleep::observe for every awake strand of this thread's blocks, with the previous
-// positions gathered from the block (the last substep's, as the reference's prev).
+// positions gathered from the block (the last substep's, as the reference's prev); the
+// forest's angular speeds for observe_speed.
 void HalenFusedModel::observe_sleep(int t, float dt) {
   const ThreadState& ts = threads_[static_cast<std::size_t>(t)];
   Vec4f* prev = prev_tmp_.data() + prev_tmp_.size() / threads_.size() * static_cast<std::size_t>(t);
@@ -239,6 +288,17 @@ void HalenFusedModel::observe_sleep(int t, float dt) {
     for (int l = 0; l < W; ++l) {
       const std::uint32_t s = b.strand[l];
       if (s == kNoStrand || sleep_.asleep(s)) continue;
+      if (model_ == Model::Forest) {
+        // A bound on the fastest vertex, as halen_forest_ref: every joint's angular speed
+        // acting over the whole strand length.
+        float omega = 0.0f;
+        for (int v = 0; v < b.n; ++v) {
+          const std::size_t k = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(l);
+          omega += std::abs(st[soa::DTH * rows + k]) + std::abs(st[soa::DPH * rows + k]);
+        }
+        sleep_.observe_speed(s, omega / inv_length_[s]);
+        continue;
+      }
       for (int v = 0; v < b.n; ++v) {
         const std::size_t k = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(l);
         prev[v] = Vec4f(st[soa::QX * rows + k], st[soa::QY * rows + k], st[soa::QZ * rows + k], 0.0f);
@@ -249,22 +309,70 @@ void HalenFusedModel::observe_sleep(int t, float dt) {
   }
 }
 
+// The forest's per-substep head poses, root inertia and colliders, and the final pose.
+void HalenFusedModel::forest_substeps(const FrameInput& in, float dt) {
+  const std::size_t nc = in.colliders.size();
+  // Grows only when a scene has more colliders than any before (reserved for 16).
+  if (spheres_.size() < nc * 4 * substep_.size()) spheres_.resize(nc * 4 * substep_.size());
+  for (int i = 1; i <= substeps_ + 1; ++i) {
+    const bool last = i > substeps_;
+    const Affine3f head =
+        last ? in.head : interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(substeps_));
+    soa::ForestSubstep& s = forest_substep_[static_cast<std::size_t>(i - 1)];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) s.m[3 * r + c] = head.linear()(r, c);
+      s.t[r] = head.translation()[r];
+    }
+    if (last) break;
+    const k::Mat34f inertia = k::root_inertia(head, head_hist_[1], head_hist_[0], dt);
+    head_hist_[0] = head_hist_[1];
+    head_hist_[1] = head;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) s.inertia[4 * r + c] = inertia(r, c);
+    float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const Vec3f center = collider_center(in.colliders[c], head);
+      sp[4 * c] = center.x();
+      sp[4 * c + 1] = center.y();
+      sp[4 * c + 2] = center.z();
+      sp[4 * c + 3] = in.colliders[c].radius;
+    }
+    s.spheres = sp;
+    s.sphere_count = static_cast<int>(nc);
+  }
+  forest_frame_.substeps = forest_substep_.data();
+  forest_frame_.substep_count = substeps_;
+  const Vec3f wind = in.wind.acceleration();
+  for (int c = 0; c < 3; ++c) {
+    forest_frame_.gravity[c] = in.gravity[c];
+    forest_frame_.wind[c] = wind[c];
+  }
+  forest_frame_.windy = in.wind.active();
+  forest_frame_.dt = dt;
+}
+
 void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
+  const bool forest = model_ == Model::Forest;
   calm_ = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm_ && sleep_.all_asleep()) {
-    // Every strand sleeps: nothing runs (issue 8).
-    for (std::string_view stage : {"references", "integrate", "length", "collision"}) times.skip(stage);
+    // Every strand sleeps: nothing runs (issue 8). The forest's head has been still for
+    // kQuietFrames frames, so head_hist_ already holds it.
+    if (forest)
+      for (std::string_view stage : {"pose", "integrate"}) times.skip(stage);
+    else
+      for (std::string_view stage : {"references", "integrate", "length", "collision"}) times.skip(stage);
     return;
   }
   const FramePlan plan = plan_frame(in, ctx_);
   const auto start = std::chrono::steady_clock::now();
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  if (forest) forest_substeps(in, dt);
   const std::size_t nc = plan.collision ? in.colliders.size() : 0;
   // Grows only when a scene has more colliders than any before (reserved for 16).
   if (spheres_.size() < nc * 4 * substep_.size()) spheres_.resize(nc * 4 * substep_.size());
   // §4.4: "z is the up vector, z_h the up vector of the head" — up is against gravity.
   const Vec3f up = in.gravity.squaredNorm() > 0.0f ? Vec3f(-in.gravity.normalized()) : Vec3f::UnitY();
-  for (int i = 1; i <= substeps_; ++i) {
+  for (int i = 1; i <= substeps_ && !forest; ++i) {
     const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(substeps_));
     soa::Substep& s = substep_[static_cast<std::size_t>(i - 1)];
     for (int r = 0; r < 3; ++r) {
@@ -327,10 +435,15 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
     }
     times.add(name, sampled > 0 ? wall_ms * static_cast<double>(ns[s]) / static_cast<double>(sampled) : 0.0);
   };
-  report("references", soa::kReferences, true);
-  report("integrate", soa::kIntegrate, true);
-  report("length", soa::kLength, true);
-  report("collision", soa::kCollision, plan.collision);
+  if (forest) {
+    report("pose", static_cast<soa::Stage>(soa::kPose), true);
+    report("integrate", static_cast<soa::Stage>(soa::kForestIntegrate), true);
+  } else {
+    report("references", soa::kReferences, true);
+    report("integrate", soa::kIntegrate, true);
+    report("length", soa::kLength, true);
+    report("collision", soa::kCollision, plan.collision);
+  }
   if (calm_) {
     StageTimer t(times, "sleep");
     if (ctx_.pool)

@@ -1,9 +1,10 @@
-// The fused Halén & Wester 2007 spring (§4.4) and cascading spaces (§4.3) models
-// (halen_spring, halen_cascade): the physics of models/halen_spring and
-// models/halen_cascade (registered as halen_*_ref), run as one structure-of-arrays pass
-// per block of 16 strands through all substeps (kernels/cpu/halen_soa.h), bit-identical
-// to the references for any thread count. Blocks are partitioned statically over the
-// threads at reset; a step allocates nothing and makes no virtual call.
+// The fused Halén & Wester 2007 models (halen_spring §4.4, halen_cascade §4.3,
+// halen_forest §4.2): the physics of models/halen_spring, models/halen_cascade and
+// models/halen_forest (registered as halen_*_ref), run as one structure-of-arrays pass per
+// block of 16 strands through all substeps (kernels/cpu/halen_soa.h). Spring and cascade
+// are bit-identical to their references, the forest agrees to rounding; all three give
+// the same bits for any thread count. Blocks are partitioned statically over the threads
+// at reset; a step allocates nothing and makes no virtual call.
 #pragma once
 
 #include "core/hair_model.h"
@@ -27,13 +28,17 @@ class HalenFusedModel final : public HairModel {
   // The blocks' fields and state, and the positions written out.
   std::size_t state_bytes() const override;
   // Replaces the run-time chosen kernel variant (tests compare the variants).
-  void use_kernel(kernels::halen_soa::FrameFn fn) { kernel_ = fn; }
+  void use_kernel(kernels::halen_soa::FrameFn fn, kernels::halen_soa::ForestFrameFn forest) {
+    kernel_ = fn;
+    forest_kernel_ = forest;
+  }
 
  private:
   static constexpr int W = kernels::halen_soa::kLanes;
   struct Region {
     float keep, tilt_min;
     int length_iterations;
+    kernels::halen_soa::ForestParams forest;
   };
   struct BlockInfo {
     std::size_t offset = 0;     // into data_
@@ -44,6 +49,7 @@ class HalenFusedModel final : public HairModel {
     bool sampled = false;       // times its stages
     std::array<std::uint32_t, W> offset_of{};  // per lane: first vertex of its strand
     std::array<std::uint32_t, W> strand{};     // per lane: the strand, or kNoStrand for a repeat
+    std::array<std::uint32_t, W> source{};     // per lane: the strand it computes (repeats included)
   };
   struct ThreadState {
     std::size_t first = 0, last = 0;  // blocks
@@ -51,6 +57,10 @@ class HalenFusedModel final : public HairModel {
     std::int64_t sampled_ns = 0;
   };
   static constexpr std::uint32_t kNoStrand = 0xffffffffu;
+  std::size_t block_floats(int n) const;
+  std::size_t state_floats(int n) const;
+  void setup_blocks(const Groom& rest, const ParamSet& params);
+  void forest_substeps(const FrameInput& in, float dt);
   void prefetch(const BlockInfo& b) const;
   void run_thread(int t);
   void observe_sleep(int t, float dt);
@@ -58,6 +68,7 @@ class HalenFusedModel final : public HairModel {
   Model model_;
   ModelContext ctx_;
   kernels::halen_soa::FrameFn kernel_;
+  kernels::halen_soa::ForestFrameFn forest_kernel_;
   std::vector<Region> region_;
   int substeps_ = 1;
   std::vector<BlockInfo> blocks_;
@@ -75,6 +86,11 @@ class HalenFusedModel final : public HairModel {
   std::vector<float> spheres_;        // per substep, x y z r per collider
   std::vector<float> spring_scale_;   // per region and substep: §4.4's tilt factor
   kernels::halen_soa::Frame frame_{};
+  // The forest's substeps (and the final head pose), frame, axes and root motion history.
+  std::vector<kernels::halen_soa::ForestSubstep> forest_substep_;
+  kernels::halen_soa::ForestFrame forest_frame_{};
+  Affine3f head_hist_[2];
+  std::vector<float> inv_length_;  // forest: 1/ℓ per strand
   bool calm_ = false;
   StrandSleep sleep_;
   std::vector<std::uint32_t> strand_begin_, strand_size_;

@@ -1,0 +1,241 @@
+// The forest block kernel of halen_soa.h (§4.2, §5.9: forest_pose and forest_integrate of
+// halen_kernels.cpp, kLanes strands at a time). Compiled once per ISA variant, like
+// halen_soa_kernel.cpp.
+#include "kernels/cpu/halen_soa.h"
+#include "kernels/cpu/vec_math.h"
+
+#include <chrono>
+#include <cmath>
+
+#ifndef HALEN_SOA_VARIANT
+#error "HALEN_SOA_VARIANT must name the ISA variant"
+#endif
+
+namespace hairbench::kernels::halen_soa::HALEN_SOA_VARIANT {
+
+namespace {
+
+constexpr int W = kLanes;
+
+#define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
+
+class Clock {
+ public:
+  explicit Clock(std::int64_t* ns) : ns_(ns) {
+    if (ns_) last_ = now();
+  }
+  void lap(ForestStage s) {
+    if (!ns_) return;
+    const std::int64_t t = now();
+    ns_[s] += t - last_;
+    last_ = t;
+  }
+
+ private:
+  static std::int64_t now() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  std::int64_t* ns_;
+  std::int64_t last_ = 0;
+};
+
+struct Rows {
+  int n;
+  const float* c;        // fields
+  float* st;             // state
+  float* f;              // frames: 9 rows per vertex, column by column
+  float *px, *py, *pz;   // positions
+  float *tx, *ty, *tz;   // joint torques
+  const RowKind* kind;
+  const float* field(int k, int i) const { return c + (static_cast<std::size_t>(k) * n + i) * W; }
+  float* state(int k, int i) const { return st + (static_cast<std::size_t>(k) * n + i) * W; }
+  float* frame(int i, int e) const { return f + (static_cast<std::size_t>(i) * 9 + e) * W; }
+};
+
+// forest_pose: segments ending at a pinned vertex follow the head rigidly; the others are
+// rebuilt from the angles, F_i = F_{i-1} R_primary(θ_i) R_y(φ_i), P_i = P_{i-1} + L_i z_i.
+void pose(const Rows& r, const ForestSubstep& h, bool parent_x) {
+  const float m0 = h.m[0], m1 = h.m[1], m2 = h.m[2], m3 = h.m[3], m4 = h.m[4], m5 = h.m[5], m6 = h.m[6],
+              m7 = h.m[7], m8 = h.m[8], t0 = h.t[0], t1 = h.t[1], t2 = h.t[2];
+  for (int i = 0; i < r.n; ++i) {
+    const int o = i * W;
+    const float *iw = r.field(FIW, i), *rx = r.field(FRX, i), *ry = r.field(FRY, i), *rz = r.field(FRZ, i);
+    float* F = r.frame(i, 0);
+    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    if (r.kind[i] != kRowFree || i == 0) {
+      const float* R = r.field(FR0, i);
+      const std::size_t fs = static_cast<std::size_t>(r.n) * W;  // field stride
+      // The root row is rigid with the head in every lane.
+      LANES {
+        const bool rigid = iw[l] == 0.0f || i == 0;
+        for (int col = 0; col < 3; ++col) {
+          const float a = R[(3 * col) * fs + l], b = R[(3 * col + 1) * fs + l], c = R[(3 * col + 2) * fs + l];
+          F[(3 * col) * W + l] = rigid ? m0 * a + m1 * b + m2 * c : F[(3 * col) * W + l];
+          F[(3 * col + 1) * W + l] = rigid ? m3 * a + m4 * b + m5 * c : F[(3 * col + 1) * W + l];
+          F[(3 * col + 2) * W + l] = rigid ? m6 * a + m7 * b + m8 * c : F[(3 * col + 2) * W + l];
+        }
+        px[l] = rigid ? t0 + (m0 * rx[l] + m1 * ry[l] + m2 * rz[l]) : px[l];
+        py[l] = rigid ? t1 + (m3 * rx[l] + m4 * ry[l] + m5 * rz[l]) : py[l];
+        pz[l] = rigid ? t2 + (m6 * rx[l] + m7 * ry[l] + m8 * rz[l]) : pz[l];
+      }
+      if (r.kind[i] == kRowPinned || i == 0) continue;
+    }
+    const float *th = r.state(TH, i), *ph = r.state(PH, i), *len = r.field(FLEN, i);
+    const float* P = r.frame(i - 1, 0);
+    const float *qx = r.px + o - W, *qy = r.py + o - W, *qz = r.pz + o - W;
+    LANES {
+      const bool free = iw[l] != 0.0f;
+      float st, ct, sp, cp;
+      sincos_poly(th[l], st, ct);
+      sincos_poly(ph[l], sp, cp);
+      // R = R_primary(θ) R_y(φ), column by column (R[3 col + row]).
+      float R[9];
+      if (parent_x) {
+        R[0] = cp, R[3] = 0.0f, R[6] = sp;
+        R[1] = st * sp, R[4] = ct, R[7] = -st * cp;
+        R[2] = -ct * sp, R[5] = st, R[8] = ct * cp;
+      } else {
+        R[0] = ct * cp, R[3] = -st, R[6] = ct * sp;
+        R[1] = st * cp, R[4] = ct, R[7] = st * sp;
+        R[2] = -sp, R[5] = 0.0f, R[8] = cp;
+      }
+      for (int col = 0; col < 3; ++col)
+        for (int row = 0; row < 3; ++row) {
+          const float e = P[row * W + l] * R[3 * col] + P[(3 + row) * W + l] * R[3 * col + 1] +
+                          P[(6 + row) * W + l] * R[3 * col + 2];
+          F[(3 * col + row) * W + l] = free ? e : F[(3 * col + row) * W + l];
+        }
+      px[l] = free ? qx[l] + len[l] * F[6 * W + l] : px[l];
+      py[l] = free ? qy[l] + len[l] * F[7 * W + l] : py[l];
+      pz[l] = free ? qz[l] + len[l] * F[8 * W + l] : pz[l];
+    }
+  }
+}
+
+// forest_integrate: one explicit Euler step of the joint angles (Eq. 4.2.1-4.2.6).
+void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, const ForestParams& p) {
+  const int n = r.n;
+  const int prim = f.parent_x ? 0 : 2;  // the parent's primary axis: column 0 (x) or 2 (z)
+  const float v = p.joint_damping, dt = f.dt;
+  const float push = p.collision_stiffness / (dt * dt);
+  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
+  const float wx = f.wind[0], wy = f.wind[1], wz = f.wind[2];
+  const float* in = h.inertia;
+  const float m0 = h.m[0], m1 = h.m[1], m2 = h.m[2], m3 = h.m[3], m4 = h.m[4], m5 = h.m[5], m6 = h.m[6],
+              m7 = h.m[7], m8 = h.m[8];
+  const std::size_t fs = static_cast<std::size_t>(n) * W;
+  // Eq. 4.2.2: each joint's spring torque (kθ + vθ')a_p + (kφ + vφ')y.
+  for (int i = 1; i < n; ++i) {
+    const int o = i * W;
+    const float *iw = r.field(FIW, i), *k = r.field(FK, i), *th0 = r.field(FTH0, i), *ph0 = r.field(FPH0, i);
+    const float *th = r.state(TH, i), *ph = r.state(PH, i), *dth = r.state(DTH, i), *dph = r.state(DPH, i);
+    const float *A = r.frame(i - 1, 3 * prim), *Y = r.frame(i, 3);
+    LANES {
+      const bool free = iw[l] != 0.0f;
+      const float a = k[l] * (th[l] - th0[l]) + v * dth[l], b = k[l] * (ph[l] - ph0[l]) + v * dph[l];
+      r.tx[o + l] = free ? a * A[l] + b * Y[l] : 0.0f;
+      r.ty[o + l] = free ? a * A[W + l] + b * Y[W + l] : 0.0f;
+      r.tz[o + l] = free ? a * A[2 * W + l] + b * Y[2 * W + l] : 0.0f;
+    }
+  }
+  alignas(64) float pax[W] = {}, pay[W] = {}, paz[W] = {};  // the parent's absolute acceleration
+  const float* inv_len = r.c + static_cast<std::size_t>(kForestFields) * fs;
+  for (int i = 1; i < n; ++i) {
+    if (r.kind[i] == kRowPinned) continue;
+    const int o = i * W;
+    const float* iw = r.field(FIW, i);
+    const float* R2 = r.field(FR6, i);  // rest frame's z column
+    const float *A = r.frame(i - 1, 3 * prim), *Y = r.frame(i, 3), *Z = r.frame(i, 6);
+    const bool child = i + 1 < n;
+    const float *ntx = r.tx + (child ? o + W : o), *nty = r.ty + (child ? o + W : o),
+                *ntz = r.tz + (child ? o + W : o);
+    float *th = r.state(TH, i), *ph = r.state(PH, i), *dth = r.state(DTH, i), *dph = r.state(DPH, i);
+    LANES {
+      const float x = r.px[o + l], y = r.py[o + l], z = r.pz[o + l];
+      const float zx = Z[l], zy = Z[W + l], zz = Z[2 * W + l];
+      // External acceleration: gravity less the root's inertia, the wind's part normal to
+      // the segment, penalty forces of the spheres the end is inside.
+      float ax = gx - (in[0] * x + in[1] * y + in[2] * z + in[3]);
+      float ay = gy - (in[4] * x + in[5] * y + in[6] * z + in[7]);
+      float az = gz - (in[8] * x + in[9] * y + in[10] * z + in[11]);
+      if (f.windy) {
+        const float d = wx * zx + wy * zy + wz * zz;
+        ax += wx - d * zx;
+        ay += wy - d * zy;
+        az += wz - d * zz;
+      }
+      for (int c = 0; c < h.sphere_count; ++c) {
+        const float* s = h.spheres + 4 * c;
+        const float dx = x - s[0], dy = y - s[1], dz = z - s[2];
+        const float dist2 = dx * dx + dy * dy + dz * dz;
+        const bool inside = dist2 < s[3] * s[3];
+        const float dist = std::sqrt(dist2);
+        const bool off = dist > 0.0f;
+        const float g = inside ? push * (s[3] - dist) : 0.0f;
+        ax += g * (off ? dx / dist : 0.0f);
+        ay += g * (off ? dy / dist : 1.0f);
+        az += g * (off ? dz / dist : 0.0f);
+      }
+      // Gravity's torque on the head-transformed rest segment, subtracted.
+      const float rzx = m0 * R2[l] + m1 * R2[fs + l] + m2 * R2[2 * fs + l];
+      const float rzy = m3 * R2[l] + m4 * R2[fs + l] + m5 * R2[2 * fs + l];
+      const float rzz = m6 * R2[l] + m7 * R2[fs + l] + m8 * R2[2 * fs + l];
+      const float il = inv_len[l];
+      const float cx = (zy * az - zz * ay) - (rzy * gz - rzz * gy);
+      const float cy = (zz * ax - zx * az) - (rzz * gx - rzx * gz);
+      const float cz = (zx * ay - zy * ax) - (rzx * gy - rzy * gx);
+      float accx = il * cx - r.tx[o + l], accy = il * cy - r.ty[o + l], accz = il * cz - r.tz[o + l];
+      if (child) {
+        accx += ntx[l];
+        accy += nty[l];
+        accz += ntz[l];
+      }
+      // Eq. 4.2.5: relative to the parent, projected on the joint axes; Eq. 4.2.6: Euler.
+      const float relx = accx - pax[l], rely = accy - pay[l], relz = accz - paz[l];
+      const float ddth = A[l] * relx + A[W + l] * rely + A[2 * W + l] * relz;
+      const float ddph = Y[l] * relx + Y[W + l] * rely + Y[2 * W + l] * relz;
+      const bool free = iw[l] != 0.0f;
+      pax[l] = free ? accx : pax[l];
+      pay[l] = free ? accy : pay[l];
+      paz[l] = free ? accz : paz[l];
+      th[l] = free ? th[l] + dth[l] * dt : th[l];
+      ph[l] = free ? ph[l] + dph[l] * dt : ph[l];
+      dth[l] = free ? dth[l] + ddth * dt : dth[l];
+      dph[l] = free ? dph[l] + ddph * dt : dph[l];
+    }
+  }
+}
+
+void forest_frame(const Block& b, const ForestParams& p, const ForestFrame& f, float* out, float* scratch,
+                  std::int64_t* stage_ns) {
+  const int n = b.n;
+  const std::size_t rows = static_cast<std::size_t>(n) * W;
+  Rows r{n,          b.data,           b.state,          scratch,          scratch + 9 * rows,
+         scratch + 10 * rows, scratch + 11 * rows, scratch + 12 * rows, scratch + 13 * rows, scratch + 14 * rows,
+         b.rows};
+  Clock clock(stage_ns);
+  for (int k = 0; k < f.substep_count; ++k) {
+    pose(r, f.substeps[k], f.parent_x);
+    clock.lap(kPose);
+    integrate(r, f.substeps[k], f, p);
+    clock.lap(kForestIntegrate);
+  }
+  pose(r, f.substeps[f.substep_count], f.parent_x);
+  for (int l = 0; l < W; ++l) {
+    if (!b.write[l]) continue;
+    float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
+    for (int i = 0; i < n; ++i) {
+      o[4 * i] = r.px[i * W + l];
+      o[4 * i + 1] = r.py[i * W + l];
+      o[4 * i + 2] = r.pz[i * W + l];
+    }
+  }
+  clock.lap(kPose);
+}
+
+}  // namespace
+
+ForestFrameFn forest_frame_fn() { return &forest_frame; }
+
+}  // namespace hairbench::kernels::halen_soa::HALEN_SOA_VARIANT
