@@ -55,7 +55,8 @@ struct Rows {
 
 // forest_pose: segments ending at a pinned vertex follow the head rigidly; the others are
 // rebuilt from the angles, F_i = F_{i-1} R_primary(θ_i) R_y(φ_i), P_i = P_{i-1} + L_i z_i.
-void pose(const Rows& r, const ForestSubstep& h, bool parent_x) {
+template <bool kParentX>
+void pose(const Rows& r, const ForestSubstep& h) {
   const float m0 = h.m[0], m1 = h.m[1], m2 = h.m[2], m3 = h.m[3], m4 = h.m[4], m5 = h.m[5], m6 = h.m[6],
               m7 = h.m[7], m8 = h.m[8], t0 = h.t[0], t1 = h.t[1], t2 = h.t[2];
   for (int i = 0; i < r.n; ++i) {
@@ -84,31 +85,43 @@ void pose(const Rows& r, const ForestSubstep& h, bool parent_x) {
     const float *th = r.state(TH, i), *ph = r.state(PH, i), *len = r.field(FLEN, i);
     const float* P = r.frame(i - 1, 0);
     const float *qx = r.px + o - W, *qy = r.py + o - W, *qz = r.pz + o - W;
+    alignas(64) float st[W], ct[W], sp[W], cp[W];
+    LANES {
+      sincos_poly(th[l], st[l], ct[l]);
+      sincos_poly(ph[l], sp[l], cp[l]);
+    }
+    const float *P0 = P, *P1 = P + W, *P2 = P + 2 * W, *P3 = P + 3 * W, *P4 = P + 4 * W, *P5 = P + 5 * W,
+                *P6 = P + 6 * W, *P7 = P + 7 * W, *P8 = P + 8 * W;
+    float *F0 = F, *F1 = F + W, *F2 = F + 2 * W, *F3 = F + 3 * W, *F4 = F + 4 * W, *F5 = F + 5 * W, *F6 = F + 6 * W,
+          *F7 = F + 7 * W, *F8 = F + 8 * W;
     LANES {
       const bool free = iw[l] != 0.0f;
-      float st, ct, sp, cp;
-      sincos_poly(th[l], st, ct);
-      sincos_poly(ph[l], sp, cp);
-      // R = R_primary(θ) R_y(φ), column by column (R[3 col + row]).
-      float R[9];
-      if (parent_x) {
-        R[0] = cp, R[3] = 0.0f, R[6] = sp;
-        R[1] = st * sp, R[4] = ct, R[7] = -st * cp;
-        R[2] = -ct * sp, R[5] = st, R[8] = ct * cp;
-      } else {
-        R[0] = ct * cp, R[3] = -st, R[6] = ct * sp;
-        R[1] = st * cp, R[4] = ct, R[7] = st * sp;
-        R[2] = -sp, R[5] = 0.0f, R[8] = cp;
-      }
-      for (int col = 0; col < 3; ++col)
-        for (int row = 0; row < 3; ++row) {
-          const float e = P[row * W + l] * R[3 * col] + P[(3 + row) * W + l] * R[3 * col + 1] +
-                          P[(6 + row) * W + l] * R[3 * col + 2];
-          F[(3 * col + row) * W + l] = free ? e : F[(3 * col + row) * W + l];
-        }
-      px[l] = free ? qx[l] + len[l] * F[6 * W + l] : px[l];
-      py[l] = free ? qy[l] + len[l] * F[7 * W + l] : py[l];
-      pz[l] = free ? qz[l] + len[l] * F[8 * W + l] : pz[l];
+      // R = R_primary(θ) R_y(φ): R(row, col) = r<row><col>.
+      const float r00 = kParentX ? cp[l] : ct[l] * cp[l], r01 = kParentX ? 0.0f : -st[l],
+                  r02 = kParentX ? sp[l] : ct[l] * sp[l];
+      const float r10 = kParentX ? st[l] * sp[l] : st[l] * cp[l], r11 = ct[l],
+                  r12 = kParentX ? -st[l] * cp[l] : st[l] * sp[l];
+      const float r20 = kParentX ? -ct[l] * sp[l] : -sp[l], r21 = kParentX ? st[l] : 0.0f,
+                  r22 = kParentX ? ct[l] * cp[l] : cp[l];
+      // F = P R, column by column (P0..P2 the parent's x axis, P3..P5 y, P6..P8 z).
+      const float f0 = P0[l] * r00 + P3[l] * r10 + P6[l] * r20, f1 = P1[l] * r00 + P4[l] * r10 + P7[l] * r20,
+                  f2 = P2[l] * r00 + P5[l] * r10 + P8[l] * r20;
+      const float f3 = P0[l] * r01 + P3[l] * r11 + P6[l] * r21, f4 = P1[l] * r01 + P4[l] * r11 + P7[l] * r21,
+                  f5 = P2[l] * r01 + P5[l] * r11 + P8[l] * r21;
+      const float f6 = P0[l] * r02 + P3[l] * r12 + P6[l] * r22, f7 = P1[l] * r02 + P4[l] * r12 + P7[l] * r22,
+                  f8 = P2[l] * r02 + P5[l] * r12 + P8[l] * r22;
+      F0[l] = free ? f0 : F0[l];
+      F1[l] = free ? f1 : F1[l];
+      F2[l] = free ? f2 : F2[l];
+      F3[l] = free ? f3 : F3[l];
+      F4[l] = free ? f4 : F4[l];
+      F5[l] = free ? f5 : F5[l];
+      F6[l] = free ? f6 : F6[l];
+      F7[l] = free ? f7 : F7[l];
+      F8[l] = free ? f8 : F8[l];
+      px[l] = free ? qx[l] + len[l] * f6 : px[l];
+      py[l] = free ? qy[l] + len[l] * f7 : py[l];
+      pz[l] = free ? qz[l] + len[l] * f8 : pz[l];
     }
   }
 }
@@ -151,40 +164,49 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
     const float *ntx = r.tx + (child ? o + W : o), *nty = r.ty + (child ? o + W : o),
                 *ntz = r.tz + (child ? o + W : o);
     float *th = r.state(TH, i), *ph = r.state(PH, i), *dth = r.state(DTH, i), *dph = r.state(DPH, i);
+    const float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    // External acceleration: gravity less the root's inertia, the wind's part normal to
+    // the segment, penalty forces of the spheres the end is inside.
+    alignas(64) float ax[W], ay[W], az[W];
     LANES {
-      const float x = r.px[o + l], y = r.py[o + l], z = r.pz[o + l];
-      const float zx = Z[l], zy = Z[W + l], zz = Z[2 * W + l];
-      // External acceleration: gravity less the root's inertia, the wind's part normal to
-      // the segment, penalty forces of the spheres the end is inside.
-      float ax = gx - (in[0] * x + in[1] * y + in[2] * z + in[3]);
-      float ay = gy - (in[4] * x + in[5] * y + in[6] * z + in[7]);
-      float az = gz - (in[8] * x + in[9] * y + in[10] * z + in[11]);
-      if (f.windy) {
+      const float x = px[l], y = py[l], z = pz[l];
+      ax[l] = gx - (in[0] * x + in[1] * y + in[2] * z + in[3]);
+      ay[l] = gy - (in[4] * x + in[5] * y + in[6] * z + in[7]);
+      az[l] = gz - (in[8] * x + in[9] * y + in[10] * z + in[11]);
+    }
+    if (f.windy)
+      LANES {
+        const float zx = Z[l], zy = Z[W + l], zz = Z[2 * W + l];
         const float d = wx * zx + wy * zy + wz * zz;
-        ax += wx - d * zx;
-        ay += wy - d * zy;
-        az += wz - d * zz;
+        ax[l] += wx - d * zx;
+        ay[l] += wy - d * zy;
+        az[l] += wz - d * zz;
       }
-      for (int c = 0; c < h.sphere_count; ++c) {
-        const float* s = h.spheres + 4 * c;
-        const float dx = x - s[0], dy = y - s[1], dz = z - s[2];
+    for (int c = 0; c < h.sphere_count; ++c) {
+      const float sx = h.spheres[4 * c], sy = h.spheres[4 * c + 1], sz = h.spheres[4 * c + 2],
+                  rad = h.spheres[4 * c + 3];
+      LANES {
+        const float dx = px[l] - sx, dy = py[l] - sy, dz = pz[l] - sz;
         const float dist2 = dx * dx + dy * dy + dz * dz;
-        const bool inside = dist2 < s[3] * s[3];
+        const bool inside = dist2 < rad * rad;
         const float dist = std::sqrt(dist2);
         const bool off = dist > 0.0f;
-        const float g = inside ? push * (s[3] - dist) : 0.0f;
-        ax += g * (off ? dx / dist : 0.0f);
-        ay += g * (off ? dy / dist : 1.0f);
-        az += g * (off ? dz / dist : 0.0f);
+        const float g = inside ? push * (rad - dist) : 0.0f;
+        ax[l] += g * (off ? dx / dist : 0.0f);
+        ay[l] += g * (off ? dy / dist : 1.0f);
+        az[l] += g * (off ? dz / dist : 0.0f);
       }
+    }
+    LANES {
+      const float zx = Z[l], zy = Z[W + l], zz = Z[2 * W + l];
       // Gravity's torque on the head-transformed rest segment, subtracted.
       const float rzx = m0 * R2[l] + m1 * R2[fs + l] + m2 * R2[2 * fs + l];
       const float rzy = m3 * R2[l] + m4 * R2[fs + l] + m5 * R2[2 * fs + l];
       const float rzz = m6 * R2[l] + m7 * R2[fs + l] + m8 * R2[2 * fs + l];
       const float il = inv_len[l];
-      const float cx = (zy * az - zz * ay) - (rzy * gz - rzz * gy);
-      const float cy = (zz * ax - zx * az) - (rzz * gx - rzx * gz);
-      const float cz = (zx * ay - zy * ax) - (rzx * gy - rzy * gx);
+      const float cx = (zy * az[l] - zz * ay[l]) - (rzy * gz - rzz * gy);
+      const float cy = (zz * ax[l] - zx * az[l]) - (rzz * gx - rzx * gz);
+      const float cz = (zx * ay[l] - zy * ax[l]) - (rzx * gy - rzy * gx);
       float accx = il * cx - r.tx[o + l], accy = il * cy - r.ty[o + l], accz = il * cz - r.tz[o + l];
       if (child) {
         accx += ntx[l];
@@ -216,12 +238,18 @@ void forest_frame(const Block& b, const ForestParams& p, const ForestFrame& f, f
          b.rows};
   Clock clock(stage_ns);
   for (int k = 0; k < f.substep_count; ++k) {
-    pose(r, f.substeps[k], f.parent_x);
+    if (f.parent_x)
+      pose<true>(r, f.substeps[k]);
+    else
+      pose<false>(r, f.substeps[k]);
     clock.lap(kPose);
     integrate(r, f.substeps[k], f, p);
     clock.lap(kForestIntegrate);
   }
-  pose(r, f.substeps[f.substep_count], f.parent_x);
+  if (f.parent_x)
+    pose<true>(r, f.substeps[f.substep_count]);
+  else
+    pose<false>(r, f.substeps[f.substep_count]);
   for (int l = 0; l < W; ++l) {
     if (!b.write[l]) continue;
     float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
