@@ -15,6 +15,9 @@ namespace k = hairbench::kernels;
 
 // One block in this many (and the first of every region) times its stages.
 constexpr std::size_t kSampleEvery = 16;
+// Blocks ahead whose data is prefetched: with few substeps a block computes in less time
+// than one block's memory takes to arrive.
+constexpr std::size_t kPrefetchAhead = 2;
 
 HalenFusedModel::HalenFusedModel(Model model, const ModelContext& ctx)
     : model_(model), ctx_(ctx), kernel_(soa::frame_kernel()), forest_kernel_(soa::forest_kernel()) {}
@@ -250,7 +253,9 @@ void HalenFusedModel::run_thread(int t) {
       asleep += sleeps;
     }
     if (awake == 0) continue;  // every strand of the block sleeps
-    if (i + 1 < ts.last) prefetch(blocks_[i + 1]);
+    if (i == ts.first)
+      for (std::size_t k = 1; k < kPrefetchAhead && i + k < ts.last; ++k) prefetch(blocks_[i + k]);
+    if (i + kPrefetchAhead < ts.last) prefetch(blocks_[i + kPrefetchAhead]);
     float* state = state_.data() + b.state;
     const std::size_t state_floats = soa::state_floats(b.n);
     if (asleep > 0) std::copy_n(state, state_floats, backup);
