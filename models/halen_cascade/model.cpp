@@ -41,6 +41,13 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   down_ref_.assign(nv, Vec3f::Zero());
 }
 
+std::size_t CascadeModel::state_bytes() const {
+  return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
+         (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size()) * sizeof(float) +
+         (rest_space_.size() + space_.size()) * sizeof(kernels::Mat3f) +
+         (up_local_.size() + down_local_.size() + up_ref_.size() + down_ref_.size()) * sizeof(Vec3f);
+}
+
 template <class T>
 std::span<T> CascadeModel::strand(std::vector<T>& v, std::size_t s) {
   return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));

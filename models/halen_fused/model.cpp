@@ -125,12 +125,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   head_hist_[0] = head_hist_[1] = Affine3f::Identity();
   spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
   spring_scale_.assign(region_.size() * static_cast<std::size_t>(substeps_), 1.0f);
-  strand_begin_.resize(rest.strand_count());
-  strand_size_.resize(rest.strand_count());
-  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    strand_begin_[s] = rest.strand_begin(s);
-    strand_size_[s] = rest.strand_size(s);
-  }
+  strand_begin_.assign(rest.strand_offsets.begin(), rest.strand_offsets.end() - 1);
   pos_ = rest.positions;
   sleep_.reset(rest.strand_count());
 }

@@ -93,7 +93,7 @@ class HalenFusedModel final : public HairModel {
   std::vector<float> inv_length_;  // forest: 1/ℓ per strand
   bool calm_ = false;
   StrandSleep sleep_;
-  std::vector<std::uint32_t> strand_begin_, strand_size_;
+  std::vector<std::uint32_t> strand_begin_;
   std::vector<Vec4f> pos_;
 };
 

@@ -35,6 +35,12 @@ void SpringModel::reset(const Groom& rest, const ParamSet& params) {
   ref_.assign(rest.vertex_count(), Vec3f::Zero());
 }
 
+std::size_t SpringModel::state_bytes() const {
+  return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
+         (rest_length_.size() + k_.size() + lift_.size()) * sizeof(float) +
+         (ref_local_.size() + ref_.size()) * sizeof(Vec3f);
+}
+
 template <class T>
 std::span<T> SpringModel::strand(std::vector<T>& v, std::size_t s) {
   return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));

@@ -19,6 +19,8 @@ class SpringModel final : public HairModel {
   void reset(const Groom& rest, const ParamSet& params) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
+  // Every per-vertex array a step reads or writes.
+  std::size_t state_bytes() const override;
 
  private:
   struct RegionSettings {
