@@ -46,74 +46,76 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
   substeps_ = params.get_int("substeps");
 
-  // Blocks: strands of one region and one vertex count, W at a time (ragged grooms give
-  // one partly filled block per (region, count); its idle lanes repeat a strand of the
-  // block and are never written back).
-  std::vector<std::uint32_t> order(rest.strand_count());
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    if (rest.strand_region[a] != rest.strand_region[b]) return rest.strand_region[a] < rest.strand_region[b];
-    return rest.strand_size(a) < rest.strand_size(b);
-  });
+  // Threads: contiguous ranges of strands of about equal cost (vertices times passes over
+  // them), fixed at reset, so that no two threads write the same cache line of the
+  // positions. Blocks: within a thread's range, strands of one region and one vertex
+  // count, W at a time (ragged grooms give one partly filled block per (region, count);
+  // its idle lanes repeat a strand of the block and are never written back). Every lane's
+  // result depends only on its own strand, so the state is the same for any thread count
+  // and any grouping.
+  const int threads = ctx_.pool ? ctx_.pool->threads() : 1;
+  const std::size_t strands = rest.strand_count();
+  auto cost = [&](std::size_t s) {
+    return static_cast<double>(rest.strand_size(s)) * (4.0 + region_[rest.strand_region[s]].length_iterations);
+  };
+  double total = 0.0;
+  for (std::size_t s = 0; s < strands; ++s) total += cost(s);
+  threads_.assign(static_cast<std::size_t>(threads), ThreadState{});
   blocks_.clear();
   row_kinds_.clear();
   std::size_t floats = 0, state = 0;
   int max_n = 0;
-  for (std::size_t i = 0; i < order.size();) {
-    const std::uint16_t region = rest.strand_region[order[i]];
-    const int n = static_cast<int>(rest.strand_size(order[i]));
-    std::size_t j = i;
-    while (j < order.size() && j - i < static_cast<std::size_t>(W) && rest.strand_region[order[j]] == region &&
-           static_cast<int>(rest.strand_size(order[j])) == n)
-      ++j;
-    BlockInfo b;
-    b.offset = floats;
-    b.state = state;
-    b.rows = row_kinds_.size();
-    b.n = n;
-    b.region = region;
-    b.sampled = blocks_.size() % kSampleEvery == 0 || blocks_.empty() || blocks_.back().region != region;
-    for (int l = 0; l < W; ++l) {
-      const bool used = i + static_cast<std::size_t>(l) < j;
-      const std::uint32_t s = order[used ? i + l : j - 1];
-      b.offset_of[l] = rest.strand_begin(s);
-      b.strand[l] = used ? s : kNoStrand;
-      b.source[l] = s;
+  double acc = 0.0;
+  std::size_t next = 0;
+  for (int t = 0; t < threads; ++t) {
+    const std::size_t first = next;
+    const double end = total * (t + 1) / threads;
+    while (next < strands && (t == threads - 1 || acc + 0.5 * cost(next) < end)) acc += cost(next++);
+    std::vector<std::uint32_t> order(next - first);
+    std::iota(order.begin(), order.end(), static_cast<std::uint32_t>(first));
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      if (rest.strand_region[a] != rest.strand_region[b]) return rest.strand_region[a] < rest.strand_region[b];
+      return rest.strand_size(a) < rest.strand_size(b);
+    });
+    threads_[t].first = blocks_.size();
+    for (std::size_t i = 0; i < order.size();) {
+      const std::uint16_t region = rest.strand_region[order[i]];
+      const int n = static_cast<int>(rest.strand_size(order[i]));
+      std::size_t j = i;
+      while (j < order.size() && j - i < static_cast<std::size_t>(W) && rest.strand_region[order[j]] == region &&
+             static_cast<int>(rest.strand_size(order[j])) == n)
+        ++j;
+      BlockInfo b;
+      b.offset = floats;
+      b.state = state;
+      b.rows = row_kinds_.size();
+      b.n = n;
+      b.region = region;
+      b.sampled = blocks_.size() % kSampleEvery == 0 || blocks_.empty() || blocks_.back().region != region;
+      for (int l = 0; l < W; ++l) {
+        const bool used = i + static_cast<std::size_t>(l) < j;
+        const std::uint32_t s = order[used ? i + l : j - 1];
+        b.offset_of[l] = rest.strand_begin(s);
+        b.strand[l] = used ? s : kNoStrand;
+        b.source[l] = s;
+      }
+      for (int v = 0; v < n; ++v) {
+        int pinned = 0;
+        for (int l = 0; l < W; ++l) pinned += rest.positions[b.offset_of[l] + v].w() == 0.0f;
+        row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
+      }
+      floats += block_floats(n);
+      state += state_floats(n);
+      max_n = std::max(max_n, n);
+      blocks_.push_back(b);
+      i = j;
     }
-    for (int v = 0; v < n; ++v) {
-      int pinned = 0;
-      for (int l = 0; l < W; ++l) pinned += rest.positions[b.offset_of[l] + v].w() == 0.0f;
-      row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
-    }
-    floats += block_floats(n);
-    state += state_floats(n);
-    max_n = std::max(max_n, n);
-    blocks_.push_back(b);
-    i = j;
+    threads_[t].last = blocks_.size();
   }
   data_.assign(floats, 0.0f);
   state_.assign(state, 0.0f);
   setup_blocks(rest, params);
 
-  // Static partition of the blocks over the threads by estimated cost (vertices times
-  // passes over them), fixed at reset: which thread runs a block never changes a bit of
-  // its result, so any thread count gives the same state.
-  const int threads = ctx_.pool ? ctx_.pool->threads() : 1;
-  std::vector<double> cost(blocks_.size());
-  double total = 0.0;
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    cost[b] = blocks_[b].n * (4.0 + region_[blocks_[b].region].length_iterations);
-    total += cost[b];
-  }
-  threads_.assign(static_cast<std::size_t>(threads), ThreadState{});
-  double acc = 0.0;
-  std::size_t next = 0;
-  for (int t = 0; t < threads; ++t) {
-    threads_[t].first = next;
-    const double end = total * (t + 1) / threads;
-    while (next < blocks_.size() && (t == threads - 1 || acc + 0.5 * cost[next] < end)) acc += cost[next++];
-    threads_[t].last = next;
-  }
   scratch_stride_ = forest ? soa::forest_scratch_floats(max_n) : soa::scratch_floats(max_n);
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
   backup_stride_ = state_floats(max_n);
