@@ -41,11 +41,12 @@ enum Field : int {
 // The cascade keeps the rest tangent space of the root segment ([B N T], 9 rows, column
 // by column) after its fields.
 inline constexpr int kRootSpaceRows = 9;
-inline constexpr std::size_t block_floats(Model m, int n) {
+inline constexpr std::size_t block_floats(Model m, int n) {  // Spring or Cascade
   return m == Model::Spring ? static_cast<std::size_t>(kSpringFields * n) * kLanes
                             : static_cast<std::size_t>(kCascadeFields * n + kRootSpaceRows) * kLanes;
 }
-// The state of a block, n rows of kLanes floats each, persistent across frames.
+// The state of a block (Spring or Cascade), n rows of kLanes floats each, persistent
+// across frames.
 enum StateField : int { PX, PY, PZ, QX, QY, QZ, kStateFields };  // positions, previous positions
 inline constexpr std::size_t state_floats(int n) { return static_cast<std::size_t>(kStateFields * n) * kLanes; }
 // Per-thread scratch for a block of n vertices: the world-space reference nodes (one set

@@ -222,10 +222,10 @@ std::size_t HalenFusedModel::state_bytes() const {
 void HalenFusedModel::prefetch(const BlockInfo& b) const {
   constexpr std::size_t kLine = 64;
   const char* d = reinterpret_cast<const char*>(data_.data() + b.offset);
-  const std::size_t bytes = soa::block_floats(model_, b.n) * sizeof(float);
+  const std::size_t bytes = block_floats(b.n) * sizeof(float);
   for (std::size_t o = 0; o < bytes; o += kLine) __builtin_prefetch(d + o, 0, 3);
   const char* st = reinterpret_cast<const char*>(state_.data() + b.state);
-  for (std::size_t o = 0; o < soa::state_floats(b.n) * sizeof(float); o += kLine) __builtin_prefetch(st + o, 1, 3);
+  for (std::size_t o = 0; o < state_floats(b.n) * sizeof(float); o += kLine) __builtin_prefetch(st + o, 1, 3);
   for (int l = 0; l < W; ++l) {
     if (b.strand[l] == kNoStrand) continue;
     const char* p = reinterpret_cast<const char*>(pos_.data() + b.offset_of[l]);
@@ -254,8 +254,8 @@ void HalenFusedModel::run_thread(int t) {
       for (std::size_t k = 1; k < kPrefetchAhead && i + k < ts.last; ++k) prefetch(blocks_[i + k]);
     if (i + kPrefetchAhead < ts.last) prefetch(blocks_[i + kPrefetchAhead]);
     float* state = state_.data() + b.state;
-    const std::size_t state_floats = soa::state_floats(b.n);
-    if (asleep > 0) std::copy_n(state, state_floats, backup);
+    const std::size_t floats = state_floats(b.n);
+    if (asleep > 0) std::copy_n(state, floats, backup);
     const Region& r = region_[b.region];
     const soa::BlockParams p{r.keep, r.length_iterations,
                              spring_scale_.data() + static_cast<std::size_t>(b.region) * substep_.size()};
@@ -273,7 +273,7 @@ void HalenFusedModel::run_thread(int t) {
     // A sleeping strand is not touched (issue 8): its lane's state is put back.
     for (int l = 0; l < W; ++l)
       if (b.strand[l] != kNoStrand && !write[l])
-        for (std::size_t k = static_cast<std::size_t>(l); k < state_floats; k += W) state[k] = backup[k];
+        for (std::size_t k = static_cast<std::size_t>(l); k < floats; k += W) state[k] = backup[k];
   }
 }
 
