@@ -332,6 +332,16 @@ void wisp_positions(WispSystem& s, std::size_t w, const Vec3f& root_e1, float h)
 
 namespace {
 
+// Where the half-line x + t dir (x outside the sphere) enters the sphere: t >= 0, or -1
+// when it misses it or x is inside (the detection's case).
+float half_line_entry(const Vec3f& x, const Vec3f& dir, const Vec4f& sphere) {
+  const Vec3f xc = x - sphere.head<3>();
+  const float bb = dir.dot(xc), cc = xc.squaredNorm() - sphere.w() * sphere.w();
+  const float disc = bb * bb - cc;
+  if (!(disc >= 0.0f) || cc < 0.0f || bb > 0.0f) return -1.0f;
+  return -bb - std::sqrt(disc);
+}
+
 // The sphere whose surface is nearest to p, and the signed gap to it.
 int nearest_sphere(std::span<const Vec4f> spheres, const Vec3f& p, float& gap) {
   int best = -1;
@@ -448,6 +458,21 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
   }
 }
 
+void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body) {
+  for (std::uint32_t k = s.node_begin[w]; k < s.node_begin[w + 1]; ++k) {
+    if (s.pinned[k]) continue;
+    for (int q = 0; q < kEnvelopePerSection; ++q) {
+      const std::size_t ei = kEnvelopePerSection * k + q;
+      const int i = s.env_body[ei];
+      if (i < 0) continue;
+      const float t = half_line_entry(s.x[k], envelope_dir(s, k, q), body.spheres[i]);
+      if (t < 0.0f || s.r[ei] <= t) continue;
+      s.r[ei] = std::max(t, kMinRadiusFraction * s.r_rest[k]);
+      s.rdot[ei] = std::min(s.rdot[ei], 0.0f);
+    }
+  }
+}
+
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   // The velocity change that removes the approach and damps the tangential slip of a
@@ -468,6 +493,10 @@ void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float d
       if (s.env_body[ei] < 0) continue;
       const Vec3f dir = envelope_dir(s, k, q);
       s.rdot[ei] += slide(s.env_body[ei], s.x[k] + s.r[ei] * dir, s.v[k] + s.rdot[ei] * dir).dot(dir);
+      // The surface stops the mass on its half-line: its radial rate takes it no further
+      // than the entry point in this step (the velocity form of wisp_body_hold).
+      const float t = half_line_entry(s.x[k], dir, body.spheres[s.env_body[ei]]);
+      if (t >= 0.0f) s.rdot[ei] = std::min(s.rdot[ei], std::max(0.0f, (t - s.r[ei]) / body.h));
     }
   }
 }

@@ -175,10 +175,20 @@ struct BodyStep {
 // half-line onto the surface. A moved mass loses its velocity into the body.
 void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const Vec3f& root_e1, float threshold);
 
+// Between detections, an envelope mass the last detection found in contact with a body
+// stays out of it: where its half-line now enters the sphere nearer than the mass, the
+// mass is held at the entry point (no nearer than the radius floor) and its outward
+// radial rate, which would carry it in, is removed. Run after every position update, so
+// each correction is one step's worth of motion: an inelastic wall. Corrected only at the
+// detections, the radial spring drove the mass a period's worth into the head, and the
+// reaction's jump back re-compressed the spring 120 times a second (see wisp_body_slide).
+void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body);
+
 // Sliding contact (§4.2, a velocity modification) for the masses recorded by the last
-// detection: the relative velocity approaching the surface is removed and the
-// tangential one reduced by the fraction `drag` (viscous friction over the detection
-// period); envelope masses only along their half-lines (§5.1).
+// detection, on every integration step until the next one: the relative velocity
+// approaching the surface is removed and the tangential one reduced by the fraction
+// `drag` (viscous friction over the step); envelope masses only along their half-lines
+// (§5.1).
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag);
 
 // ---- Wisp-wisp interactions (§4.1) --------------------------------------------------

@@ -291,18 +291,16 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
         k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], in.gravity, in.wind, h);
       });
     }
-    // (2) + (3): wisp-wisp contacts are detected and responded to at the interaction
-    // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
-    // the time step").
-    if (crosses(interaction_hz_, i)) {
-      StageTimer t(times, "self_interaction");
-      detect_self_interactions();
-      k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
-    }
-    // Bodies: sliding contact for the masses the last body detection found near them,
-    // on the steps that detect (the position reaction follows the position update).
-    const bool body_due = collision_hz_ > 0.0 && body_pass && (crosses(collision_hz_, i) || i == steps);
-    if (body_due) {
+    // Bodies (§4.2): a mass the last detection found within the contact threshold is in
+    // sliding contact until the next detection, so the modification (approach removed,
+    // tangential slip dragged) applies on every integration step in between, not only on
+    // the detecting one. Applied once per detection, the masses sank into the body again
+    // between detections under gravity and their springs, and the penetration reaction
+    // threw them back out: on `idle` the position jumps re-loaded the stiff axial springs
+    // 120 times a second and held the hair in a 0.4 m/s jitter that never settled.
+    const bool body_on = collision_hz_ > 0.0 && body_pass;
+    const bool body_due = body_on && (crosses(collision_hz_, i) || i == steps);
+    if (body_on) {
       StageTimer t(times, "body_collision");
       spheres_.clear();
       sphere_moves_.clear();
@@ -315,13 +313,29 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       body.moves = sphere_moves_;
       body.motion = head * head_before.inverse();
       body.h = h;
-      const float period = static_cast<float>(std::min(1.0 / collision_hz_, in.dt));
-      const float drag = std::min(1.0f, interaction_.body_friction * period);
+      // Viscous friction over this step.
+      const float drag = std::min(1.0f, interaction_.body_friction * h);
       for_each_wisp([&](std::size_t w) { k::wisp_body_slide(sys_, w, body, drag); });
+    }
+    // (2) + (3): wisp-wisp contacts are detected and responded to at the interaction
+    // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
+    // the time step"). After the bodies' modifications: a mass pressed against the head
+    // carries, after the force update, the step's worth of velocity into it (a h) that
+    // the sliding contact removes; seen by this response, it was handed on to the wisps
+    // touching that mass, and kept those on `idle` moving at up to 2 cm/s, 24 times a
+    // second.
+    if (crosses(interaction_hz_, i)) {
+      StageTimer t(times, "self_interaction");
+      detect_self_interactions();
+      k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
     }
     {
       StageTimer t(times, "integration");
       for_each_wisp([&](std::size_t w) { k::wisp_positions(sys_, w, head.linear() * sys_.rest_e1[w], h); });
+    }
+    if (body_on) {
+      StageTimer t(times, "body_collision");
+      for_each_wisp([&](std::size_t w) { k::wisp_body_hold(sys_, w, body); });
     }
     if (body_due) {
       StageTimer t(times, "body_collision");
