@@ -200,8 +200,8 @@ void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h) {
   }
 }
 
-void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Vec3f& gravity,
-                                const Wind& wind, float h) {
+void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                                const Vec3f& gravity, const Wind& wind, float h) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   const Vec3f wind_acc = wind.acceleration();
   const bool windy = wind.active();
@@ -264,6 +264,32 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k] += fk - damp;
     s.acc[k - 2] += fk2;
     s.acc[k - 1] -= fk + fk2 - damp;
+  }
+  // A wisp pinned at its tip as well (TressFX strands pinned at both ends) ends in a
+  // single pinned node, not in a pinned segment as at the root (§3.2): nothing held the
+  // direction of its last free segment, which swung about the pinned node like a ball
+  // joint - on tressfx_ponytail_shake the tips of the folded curls turned over by 100
+  // degrees within 5 frames, and the strands rebuilt on them stretched past 50%. The
+  // last segment gets the bending spring the first free one gets from the pinned root
+  // segment: towards its head-carried rest direction, the head taking the reaction.
+  if (e - b >= 3 && s.pinned[e - 1] && !s.pinned[e - 2]) {
+    const std::uint32_t k = e - 2;
+    const Vec3f d = s.x[e - 1] - s.x[k];
+    const float len = d.norm();
+    if (len > 0.0f) {
+      const Vec3f t = d / len;
+      const Vec3f target = head_rot * (s.rest_x[e - 1] - s.rest_x[k]).normalized();
+      const Vec3f axis = t.cross(target);
+      const float sin_angle = axis.norm();
+      if (sin_angle > 1e-7f) {
+        const float l0 = s.rest_len[e - 1];
+        const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * l0 * l0;
+        // Node k moves against the rotation of t about the pinned node.
+        s.acc[k] -= (torque / len) * (axis / sin_angle).cross(t);
+      }
+      const Vec3f dv = s.v[k] - s.v[e - 1];
+      s.acc[k] -= p.bending_damping * (dv - dv.dot(t) * t);
+    }
   }
   // Envelope (§3.3): non-linear damped radial springs to the skeleton mass, soft damped
   // springs between neighbouring envelope masses of a section; only the components

@@ -145,9 +145,9 @@ void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h);
 
 // §5.1 steps 1 and 3 (before modifications): forces, then v += a h for the skeleton
 // masses and rdot += a_r h for the envelope masses (their accelerations projected on
-// their half-lines).
-void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Vec3f& gravity,
-                                const Wind& wind, float h);
+// their half-lines). head_rot: the head's rotation (rest directions of pinned parts).
+void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                                const Vec3f& gravity, const Wind& wind, float h);
 
 // §5.1 step 4: x += v h for the skeleton, root to tip, then the new section frames, then
 // r += rdot h for the envelope (kept within 0.25 and 2 times its rest radius).

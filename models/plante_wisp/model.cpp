@@ -288,7 +288,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       StageTimer t(times, "integration");
       for_each_wisp([&](std::size_t w) {
         k::wisp_pin(sys_, w, head, h);
-        k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], in.gravity, in.wind, h);
+        k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head.linear(), in.gravity, in.wind, h);
       });
     }
     // Bodies (§4.2): a mass the last detection found within the contact threshold is in
