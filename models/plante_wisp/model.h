@@ -11,6 +11,9 @@
 #include "kernels/cpu/wisp_grid.h"
 #include "kernels/cpu/wisp_kernels.h"
 
+#include <array>
+#include <atomic>
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -39,8 +42,17 @@ class PlanteWispModel final : public HairModel {
 
  private:
   void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max);
+  // The stages a fused pass over the wisps times (see wisp_pass).
+  enum PassStage { kIntegration = 0, kBody = 1 };
+  struct WispClock {
+    bool on = false;
+    std::chrono::steady_clock::time_point last;
+    std::array<std::atomic<std::int64_t>*, 2> sampled_ns{};
+    void lap(int stage);  // time since the last lap to `stage`, on sampled wisps
+  };
+  // f(w, clock) for every wisp, over the threads; adds the pass's time to the stages.
   template <class F>
-  void for_each_wisp(F&& f);
+  void wisp_pass(StageTimes& times, F&& f);
   void detect_self_interactions();
 
   ModelContext ctx_;
@@ -64,6 +76,7 @@ class PlanteWispModel final : public HairModel {
   std::vector<kernels::WispContact> contacts_;
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
+  std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};
 };
 
 std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx);
