@@ -55,6 +55,8 @@ void WispSystem::resize_state() {
   racc.assign(kEnvelopePerSection * n, 0.0f);
   node_body.assign(n, -1);
   env_body.assign(kEnvelopePerSection * n, -1);
+  seg_len.assign(n, 0.0f);
+  seg_t.assign(n, Vec3f::Zero());
   node_dv.assign(n, Vec3f::Zero());
   node_dv_weight.assign(n, 0.0f);
   env_dr.assign(kEnvelopePerSection * n, 0.0f);
@@ -215,11 +217,14 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k] = a;
   }
   // Linear damped axial springs (§3.2).
+  // Each segment's length and direction are kept for the bending springs (issue 10).
   for (std::uint32_t k = b + 1; k < e; ++k) {
     const Vec3f d = s.x[k] - s.x[k - 1];
     const float len = d.norm();
+    s.seg_len[k] = len;
     if (!(len > 0.0f)) continue;
     const Vec3f t = d / len;
+    s.seg_t[k] = t;
     const float f = p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t);
     s.acc[k - 1] += f * t;
     s.acc[k] -= f * t;
@@ -241,11 +246,10 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
   // before, which takes no reaction - a follower load whose flutter grew from rounding
   // on a still head without gravity above k ~ 1e4 at 1000 Hz.
   for (std::uint32_t k = b + 2; k < e; ++k) {
-    const Vec3f d = s.x[k] - s.x[k - 1];
-    const Vec3f d_prev = s.x[k - 1] - s.x[k - 2];
-    const float len = d.norm(), len_prev = d_prev.norm();
+    const float len = s.seg_len[k], len_prev = s.seg_len[k - 1];
     if (!(len > 0.0f) || !(len_prev > 0.0f)) continue;
-    const Vec3f t = d / len, t_prev = d_prev / len_prev;
+    const Vec3f& t = s.seg_t[k];
+    const Vec3f& t_prev = s.seg_t[k - 1];
     const Vec3f& bl = s.bend_local[k];
     const Vec3f target =
         minimal_rotate(s.n[k - 2], t_prev, bl.x() * s.e1[k - 2] + bl.y() * s.e2[k - 2] + bl.z() * s.n[k - 2]);

@@ -71,6 +71,9 @@ struct WispSystem {
 
   // Body contacts found at the last body-collision detection (sphere index, -1 none).
   std::vector<std::int32_t> node_body, env_body;
+  // Scratch of wisp_forces_and_velocities: length and direction of segment (k-1, k) at k.
+  std::vector<float> seg_len;
+  std::vector<Vec3f> seg_t;
   // Per-mass velocity modification accumulators for the wisp-wisp response.
   std::vector<Vec3f> node_dv;
   std::vector<float> node_dv_weight, env_dr, env_dr_weight;
