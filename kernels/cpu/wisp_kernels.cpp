@@ -421,7 +421,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
   // A mass after one that was moved is drawn back along its axial spring to no more
   // than its rest length, so that the reaction carries the rest of the wisp along
   // instead of tearing the spring (it may then be found inside, and moved in turn).
-  bool prev_moved = false;
+  bool prev_moved = false, any_moved = false;
   for (std::uint32_t k = b; k < e; ++k) {
     s.node_body[k] = -1;
     if (s.pinned[k]) {
@@ -451,8 +451,11 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       }
     }
     prev_moved = moved;
+    any_moved = any_moved || moved;
   }
-  wisp_frames(s, w, root_e1);
+  // The frames follow the skeleton (wisp_positions built them from this state unless a
+  // mass was moved; issue 10).
+  if (any_moved) wisp_frames(s, w, root_e1);
   // Then the envelope masses, each along its half-line.
   for (std::uint32_t k = b; k < e; ++k) {
     for (int q = 0; q < kEnvelopePerSection; ++q) {
@@ -531,28 +534,43 @@ void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float d
   }
 }
 
-float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p) {
-  const Vec3f& xa = s.x[a];
-  const Vec3f& xb = s.x[a + 1];
-  const Vec3f d = xb - xa;
-  const float len2 = d.squaredNorm();
-  if (!(len2 > 0.0f)) return -1.0f;
-  const float u = (p - xa).dot(d) / len2;
-  if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
-  const Vec3f lateral = p - (xa + u * d);
-  const Vec3f t = d / std::sqrt(len2);
-  // The section axes interpolated along the segment, made orthonormal about its axis.
-  Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
-  e1 = unit_or(e1 - e1.dot(t) * t, t.unitOrthogonal());
-  const Vec3f e2 = t.cross(e1);
-  const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
-  const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
-  const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
-  const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u);
-  const float rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
-  const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
-  return f < 1.0f ? u : -1.0f;
-}
+namespace {
+
+// Segment (a, a+1)'s axis, set up once for the tests of several points (issue 10): the
+// same operations as one test, in the same order.
+struct SegmentVolume {
+  const WispSystem& s;
+  std::uint32_t a;
+  Vec3f xa, d, t;
+  float len2;
+
+  SegmentVolume(const WispSystem& sys, std::uint32_t seg) : s(sys), a(seg), xa(sys.x[seg]), d(sys.x[seg + 1] - xa) {
+    len2 = d.squaredNorm();
+    if (len2 > 0.0f) t = d / std::sqrt(len2);
+  }
+
+  float contains(const Vec3f& p) const {
+    if (!(len2 > 0.0f)) return -1.0f;
+    const float u = (p - xa).dot(d) / len2;
+    if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
+    const Vec3f lateral = p - (xa + u * d);
+    // The section axes interpolated along the segment, made orthonormal about its axis.
+    Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
+    e1 = unit_or(e1 - e1.dot(t) * t, t.unitOrthogonal());
+    const Vec3f e2 = t.cross(e1);
+    const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
+    const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
+    const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
+    const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u);
+    const float rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
+    const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
+    return f < 1.0f ? u : -1.0f;
+  }
+};
+
+}  // namespace
+
+float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p) { return SegmentVolume(s, a).contains(p); }
 
 namespace {
 
@@ -572,18 +590,16 @@ void masses_in(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vecto
   // interpolated there): where the two balls around them cannot meet, none of the five
   // masses is inside and their tests are skipped. The margin is far above rounding, so
   // no mass the full test finds is skipped (issue 10).
-  const Vec3f& xa = s.x[b];
-  const Vec3f d = s.x[b + 1] - xa;
-  const float len2 = d.squaredNorm();
-  if (len2 > 0.0f) {
-    const float u = std::clamp((s.x[k] - xa).dot(d) / len2, 0.0f, 1.0f);
+  const SegmentVolume vol(s, b);
+  if (vol.len2 > 0.0f) {
+    const float u = std::clamp((s.x[k] - vol.xa).dot(vol.d) / vol.len2, 0.0f, 1.0f);
     const float reach = 1.01f * (widest_radius(s, k) + std::max(widest_radius(s, b), widest_radius(s, b + 1)));
-    if ((s.x[k] - (xa + u * d)).squaredNorm() > reach * reach) return;
+    if ((s.x[k] - (vol.xa + u * vol.d)).squaredNorm() > reach * reach) return;
   }
-  float u = segment_contains(s, b, s.x[k]);
+  float u = vol.contains(s.x[k]);
   if (u >= 0.0f) out.push_back({k, b, u, 0});
   for (int q = 0; q < kEnvelopePerSection; ++q) {
-    u = segment_contains(s, b, envelope_point(s, k, q));
+    u = vol.contains(envelope_point(s, k, q));
     if (u >= 0.0f) out.push_back({static_cast<std::uint32_t>(kEnvelopePerSection * k + q), b, u, 1});
   }
 }

@@ -175,7 +175,9 @@ struct BodyStep {
 // of, and applies the penetration reaction root to tip: a skeleton mass inside is moved
 // out to 0.9 threshold above the surface ("slightly under the sliding contact
 // threshold"); then, with the frames rebuilt, an envelope mass inside is moved along its
-// half-line onto the surface. A moved mass loses its velocity into the body.
+// half-line onto the surface. A moved mass loses its velocity into the body. Expects
+// the section frames of the current skeleton (wisp_positions builds them), and rebuilds
+// them only if a skeleton mass moved.
 void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const Vec3f& root_e1, float threshold);
 
 // Between detections, an envelope mass the last detection found in contact with a body

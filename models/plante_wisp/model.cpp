@@ -222,6 +222,7 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   chunk_contacts_.assign(static_cast<std::size_t>(chunks), {});
   chunk_mailbox_.assign(static_cast<std::size_t>(chunks), {});
   contacts_.clear();
+  contacts_known_ = false;
   pos_ = rest.positions;
   rebuild(Affine3f::Identity());
 }
@@ -322,7 +323,12 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // threw them back out: on `idle` the position jumps re-loaded the stiff axial springs
     // 120 times a second and held the hair in a 0.4 m/s jitter that never settled.
     const bool body_on = collision_hz_ > 0.0 && body_pass;
-    const bool body_due = body_on && (crosses(collision_hz_, i) || i == steps);
+    // Also on the first step after reset: the sliding contacts above hold until the next
+    // detection, and a groom that starts inside a body would otherwise sink into it for
+    // a whole period before its first detection (the stress test's `inside_collider`:
+    // the wisps wrapped round the sphere from 8 ms deep, rebuilt strands 55% long).
+    const bool body_due = body_on && (crosses(collision_hz_, i) || i == steps || !contacts_known_);
+    contacts_known_ = contacts_known_ || body_due;
     k::BodyStep body;
     if (body_on) {
       spheres_.clear();

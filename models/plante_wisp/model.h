@@ -74,6 +74,7 @@ class PlanteWispModel final : public HairModel {
   std::vector<std::vector<kernels::WispContact>> chunk_contacts_;
   std::vector<std::vector<std::uint32_t>> chunk_mailbox_;
   std::vector<kernels::WispContact> contacts_;
+  bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
   std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};

@@ -66,6 +66,7 @@ class PlanteWispRefModel final : public HairModel {
   std::vector<std::vector<plante_ref::WispContact>> chunk_contacts_;
   std::vector<std::vector<std::uint32_t>> chunk_mailbox_;
   std::vector<plante_ref::WispContact> contacts_;
+  bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
 };
