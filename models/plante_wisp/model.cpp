@@ -268,6 +268,12 @@ void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
   if (bodies > 0.0) times.add("body_collision", ms * share);
 }
 
+std::size_t PlanteWispModel::state_bytes() const {
+  auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  return bytes(sys_.x) + bytes(sys_.v) + bytes(sys_.acc) + bytes(sys_.e1) + bytes(sys_.e2) + bytes(sys_.n) +
+         bytes(sys_.r) + bytes(sys_.rdot) + bytes(sys_.racc) + bytes(pos_);
+}
+
 void PlanteWispModel::detect_self_interactions() {
   k::grid_build(grid_, sys_);
   const std::size_t n = grid_.size(), chunks = chunk_contacts_.size();

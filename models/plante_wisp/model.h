@@ -26,6 +26,9 @@ class PlanteWispModel final : public HairModel {
   // Stages: "integration", "body_collision", "self_interaction", "rebuild".
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
+  // What a step reads and writes: the skeleton's and envelope's state and forces, the
+  // section frames, and the rebuilt strands.
+  std::size_t state_bytes() const override;
 
   // The simulation state, for tests and inspection. Tests may edit velocities.
   const kernels::WispSystem& wisps() const { return sys_; }
