@@ -30,7 +30,7 @@ const std::vector<std::string> kSleepers = kCpuModels;
 // kQuietFrames. plante_wisp is slower: its slowest mode is damped by air resistance
 // alone (5/s), and its wisps slide down the head against viscous friction (§4.2) until
 // their bending springs hold them; measured on the thinned `idle`, its fastest mass falls
-// below 1e-4 m/s after about 6 s (1.4e-4 at 5 s, 9.9e-5 at 6 s, 2.7e-5 at 12 s).
+// below 1e-4 m/s after about 7.5 s (2.7e-4 at 5 s, 1.6e-4 at 6 s, 9e-5 at 8 s, 6e-5 at 12 s).
 double settle_seconds(const std::string& model) { return model == "plante_wisp" ? 9.0 : 2.0; }
 
 struct Simulation {
