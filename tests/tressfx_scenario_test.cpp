@@ -296,7 +296,10 @@ TEST(TressfxScenario, PonytailProjectStaysStableWithHanModels) {
     const Scenario sc = load_scenario(file);
     EXPECT_EQ(sc.follow.has_value(), std::string(mode) == "follow");
     EXPECT_EQ(sc.groom.strand_count(), ((876 + 23) / 24 + (3066 + 23) / 24 + (517 + 23) / 24 + (474 + 23) / 24) * 5u);
-    for (const RunRecord& r : test::run(sc, test::kHan)) {
+    // plante_wisp too: the folded curls' wisps are pinned at both ends (issue 5).
+    std::vector<std::string> models = test::kHan;
+    models.push_back("plante_wisp");
+    for (const RunRecord& r : test::run(sc, models)) {
       SCOPED_TRACE(r.model);
       ASSERT_FALSE(r.failure.has_value()) << "frame " << r.failure->frame << ": " << r.failure->reason;
       ASSERT_EQ(r.length_max.size(), 130u);
@@ -307,7 +310,10 @@ TEST(TressfxScenario, PonytailProjectStaysStableWithHanModels) {
         // Every strand simulated: every edge within the 50% bound, and the collision
         // pass, the last stage of each substep, leaves no vertex inside a sphere.
         EXPECT_LT(test::max_of(r.length_max), 0.5);
-        EXPECT_LT(test::max_of(r.penetration), 1e-3);
+        // plante_wisp collides its wisps' masses (tests/plante_test.cpp); its strands are
+        // rebuilt inside the envelopes afterwards (§5.2) and may cut into a sphere
+        // between two masses (5.4 mm here).
+        if (r.model != "plante_wisp") EXPECT_LT(test::max_of(r.penetration), 1e-3);
       }
     }
   }

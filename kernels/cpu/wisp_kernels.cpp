@@ -55,6 +55,8 @@ void WispSystem::resize_state() {
   racc.assign(kEnvelopePerSection * n, 0.0f);
   node_body.assign(n, -1);
   env_body.assign(kEnvelopePerSection * n, -1);
+  seg_len.assign(n, 0.0f);
+  seg_t.assign(n, Vec3f::Zero());
   node_dv.assign(n, Vec3f::Zero());
   node_dv_weight.assign(n, 0.0f);
   env_dr.assign(kEnvelopePerSection * n, 0.0f);
@@ -200,8 +202,8 @@ void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h) {
   }
 }
 
-void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Vec3f& gravity,
-                                const Wind& wind, float h) {
+void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                                const Vec3f& gravity, const Wind& wind, float h) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   const Vec3f wind_acc = wind.acceleration();
   const bool windy = wind.active();
@@ -215,11 +217,14 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k] = a;
   }
   // Linear damped axial springs (§3.2).
+  // Each segment's length and direction are kept for the bending springs (issue 10).
   for (std::uint32_t k = b + 1; k < e; ++k) {
     const Vec3f d = s.x[k] - s.x[k - 1];
     const float len = d.norm();
+    s.seg_len[k] = len;
     if (!(len > 0.0f)) continue;
     const Vec3f t = d / len;
+    s.seg_t[k] = t;
     const float f = p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t);
     s.acc[k - 1] += f * t;
     s.acc[k] -= f * t;
@@ -241,11 +246,10 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
   // before, which takes no reaction - a follower load whose flutter grew from rounding
   // on a still head without gravity above k ~ 1e4 at 1000 Hz.
   for (std::uint32_t k = b + 2; k < e; ++k) {
-    const Vec3f d = s.x[k] - s.x[k - 1];
-    const Vec3f d_prev = s.x[k - 1] - s.x[k - 2];
-    const float len = d.norm(), len_prev = d_prev.norm();
+    const float len = s.seg_len[k], len_prev = s.seg_len[k - 1];
     if (!(len > 0.0f) || !(len_prev > 0.0f)) continue;
-    const Vec3f t = d / len, t_prev = d_prev / len_prev;
+    const Vec3f& t = s.seg_t[k];
+    const Vec3f& t_prev = s.seg_t[k - 1];
     const Vec3f& bl = s.bend_local[k];
     const Vec3f target =
         minimal_rotate(s.n[k - 2], t_prev, bl.x() * s.e1[k - 2] + bl.y() * s.e2[k - 2] + bl.z() * s.n[k - 2]);
@@ -264,6 +268,32 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k] += fk - damp;
     s.acc[k - 2] += fk2;
     s.acc[k - 1] -= fk + fk2 - damp;
+  }
+  // A wisp pinned at its tip as well (TressFX strands pinned at both ends) ends in a
+  // single pinned node, not in a pinned segment as at the root (§3.2): nothing held the
+  // direction of its last free segment, which swung about the pinned node like a ball
+  // joint - on tressfx_ponytail_shake the tips of the folded curls turned over by 100
+  // degrees within 5 frames, and the strands rebuilt on them stretched past 50%. The
+  // last segment gets the bending spring the first free one gets from the pinned root
+  // segment: towards its head-carried rest direction, the head taking the reaction.
+  if (e - b >= 3 && s.pinned[e - 1] && !s.pinned[e - 2]) {
+    const std::uint32_t k = e - 2;
+    const Vec3f d = s.x[e - 1] - s.x[k];
+    const float len = d.norm();
+    if (len > 0.0f) {
+      const Vec3f t = d / len;
+      const Vec3f target = head_rot * (s.rest_x[e - 1] - s.rest_x[k]).normalized();
+      const Vec3f axis = t.cross(target);
+      const float sin_angle = axis.norm();
+      if (sin_angle > 1e-7f) {
+        const float l0 = s.rest_len[e - 1];
+        const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * l0 * l0;
+        // Node k moves against the rotation of t about the pinned node.
+        s.acc[k] -= (torque / len) * (axis / sin_angle).cross(t);
+      }
+      const Vec3f dv = s.v[k] - s.v[e - 1];
+      s.acc[k] -= p.bending_damping * (dv - dv.dot(t) * t);
+    }
   }
   // Envelope (§3.3): non-linear damped radial springs to the skeleton mass, soft damped
   // springs between neighbouring envelope masses of a section; only the components
@@ -332,6 +362,16 @@ void wisp_positions(WispSystem& s, std::size_t w, const Vec3f& root_e1, float h)
 
 namespace {
 
+// Where the half-line x + t dir (x outside the sphere) enters the sphere: t >= 0, or -1
+// when it misses it or x is inside (the detection's case).
+float half_line_entry(const Vec3f& x, const Vec3f& dir, const Vec4f& sphere) {
+  const Vec3f xc = x - sphere.head<3>();
+  const float bb = dir.dot(xc), cc = xc.squaredNorm() - sphere.w() * sphere.w();
+  const float disc = bb * bb - cc;
+  if (!(disc >= 0.0f) || cc < 0.0f || bb > 0.0f) return -1.0f;
+  return -bb - std::sqrt(disc);
+}
+
 // The sphere whose surface is nearest to p, and the signed gap to it.
 int nearest_sphere(std::span<const Vec4f> spheres, const Vec3f& p, float& gap) {
   int best = -1;
@@ -381,7 +421,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
   // A mass after one that was moved is drawn back along its axial spring to no more
   // than its rest length, so that the reaction carries the rest of the wisp along
   // instead of tearing the spring (it may then be found inside, and moved in turn).
-  bool prev_moved = false;
+  bool prev_moved = false, any_moved = false;
   for (std::uint32_t k = b; k < e; ++k) {
     s.node_body[k] = -1;
     if (s.pinned[k]) {
@@ -411,8 +451,11 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       }
     }
     prev_moved = moved;
+    any_moved = any_moved || moved;
   }
-  wisp_frames(s, w, root_e1);
+  // The frames follow the skeleton (wisp_positions built them from this state unless a
+  // mass was moved; issue 10).
+  if (any_moved) wisp_frames(s, w, root_e1);
   // Then the envelope masses, each along its half-line.
   for (std::uint32_t k = b; k < e; ++k) {
     for (int q = 0; q < kEnvelopePerSection; ++q) {
@@ -448,6 +491,21 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
   }
 }
 
+void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body) {
+  for (std::uint32_t k = s.node_begin[w]; k < s.node_begin[w + 1]; ++k) {
+    if (s.pinned[k]) continue;
+    for (int q = 0; q < kEnvelopePerSection; ++q) {
+      const std::size_t ei = kEnvelopePerSection * k + q;
+      const int i = s.env_body[ei];
+      if (i < 0) continue;
+      const float t = half_line_entry(s.x[k], envelope_dir(s, k, q), body.spheres[i]);
+      if (t < 0.0f || s.r[ei] <= t) continue;
+      s.r[ei] = std::max(t, kMinRadiusFraction * s.r_rest[k]);
+      s.rdot[ei] = std::min(s.rdot[ei], 0.0f);
+    }
+  }
+}
+
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   // The velocity change that removes the approach and damps the tangential slip of a
@@ -468,43 +526,80 @@ void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float d
       if (s.env_body[ei] < 0) continue;
       const Vec3f dir = envelope_dir(s, k, q);
       s.rdot[ei] += slide(s.env_body[ei], s.x[k] + s.r[ei] * dir, s.v[k] + s.rdot[ei] * dir).dot(dir);
+      // The surface stops the mass on its half-line: its radial rate takes it no further
+      // than the entry point in this step (the velocity form of wisp_body_hold).
+      const float t = half_line_entry(s.x[k], dir, body.spheres[s.env_body[ei]]);
+      if (t >= 0.0f) s.rdot[ei] = std::min(s.rdot[ei], std::max(0.0f, (t - s.r[ei]) / body.h));
     }
   }
 }
 
-float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p) {
-  const Vec3f& xa = s.x[a];
-  const Vec3f d = s.x[a + 1] - xa;
-  const float len2 = d.squaredNorm();
-  if (!(len2 > 0.0f)) return -1.0f;
-  const float u = (p - xa).dot(d) / len2;
-  if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
-  const Vec3f t = d / std::sqrt(len2);
-  const Vec3f lateral = p - (xa + u * d);
-  // The section axes interpolated along the segment, made orthonormal about its axis.
-  Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
-  e1 = unit_or(e1 - e1.dot(t) * t, t.unitOrthogonal());
-  const Vec3f e2 = t.cross(e1);
-  const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
-  const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
-  const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
-  const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u);
-  const float rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
-  const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
-  return f < 1.0f ? u : -1.0f;
-}
+namespace {
+
+// Segment (a, a+1)'s axis, set up once for the tests of several points (issue 10): the
+// same operations as one test, in the same order.
+struct SegmentVolume {
+  const WispSystem& s;
+  std::uint32_t a;
+  Vec3f xa, d, t;
+  float len2;
+
+  SegmentVolume(const WispSystem& sys, std::uint32_t seg) : s(sys), a(seg), xa(sys.x[seg]), d(sys.x[seg + 1] - xa) {
+    len2 = d.squaredNorm();
+    if (len2 > 0.0f) t = d / std::sqrt(len2);
+  }
+
+  float contains(const Vec3f& p) const {
+    if (!(len2 > 0.0f)) return -1.0f;
+    const float u = (p - xa).dot(d) / len2;
+    if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
+    const Vec3f lateral = p - (xa + u * d);
+    // The section axes interpolated along the segment, made orthonormal about its axis.
+    Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
+    e1 = unit_or(e1 - e1.dot(t) * t, t.unitOrthogonal());
+    const Vec3f e2 = t.cross(e1);
+    const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
+    const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
+    const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
+    const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u);
+    const float rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
+    const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
+    return f < 1.0f ? u : -1.0f;
+  }
+};
+
+}  // namespace
+
+float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p) { return SegmentVolume(s, a).contains(p); }
 
 namespace {
 
 // The masses of segment (a, a+1) - node a+1 and its envelope - tested against the
 // volume of segment b.
+// Widest envelope radius of node k.
+float widest_radius(const WispSystem& s, std::uint32_t k) {
+  const float* r = &s.r[kEnvelopePerSection * k];
+  return std::max(std::max(r[0], r[1]), std::max(r[2], r[3]));
+}
+
 void masses_in(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vector<WispContact>& out) {
   const std::uint32_t k = a + 1;
   if (s.pinned[k]) return;
-  float u = segment_contains(s, b, s.x[k]);
+  // Node k's masses lie within its widest radius of x[k], and segment b's volume within
+  // its widest radius of b's axis (segment_contains: |lateral| is at most the radius
+  // interpolated there): where the two balls around them cannot meet, none of the five
+  // masses is inside and their tests are skipped. The margin is far above rounding, so
+  // no mass the full test finds is skipped (issue 10).
+  const SegmentVolume vol(s, b);
+  if (vol.len2 > 0.0f) {
+    const float u = std::clamp((s.x[k] - vol.xa).dot(vol.d) / vol.len2, 0.0f, 1.0f);
+    const float reach = 1.01f * (widest_radius(s, k) + std::max(widest_radius(s, b), widest_radius(s, b + 1)));
+    if ((s.x[k] - (vol.xa + u * vol.d)).squaredNorm() > reach * reach) return;
+  }
+  float u = vol.contains(s.x[k]);
   if (u >= 0.0f) out.push_back({k, b, u, 0});
   for (int q = 0; q < kEnvelopePerSection; ++q) {
-    u = segment_contains(s, b, envelope_point(s, k, q));
+    u = vol.contains(envelope_point(s, k, q));
     if (u >= 0.0f) out.push_back({static_cast<std::uint32_t>(kEnvelopePerSection * k + q), b, u, 1});
   }
 }

@@ -71,6 +71,9 @@ struct WispSystem {
 
   // Body contacts found at the last body-collision detection (sphere index, -1 none).
   std::vector<std::int32_t> node_body, env_body;
+  // Scratch of wisp_forces_and_velocities: length and direction of segment (k-1, k) at k.
+  std::vector<float> seg_len;
+  std::vector<Vec3f> seg_t;
   // Per-mass velocity modification accumulators for the wisp-wisp response.
   std::vector<Vec3f> node_dv;
   std::vector<float> node_dv_weight, env_dr, env_dr_weight;
@@ -145,9 +148,9 @@ void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h);
 
 // §5.1 steps 1 and 3 (before modifications): forces, then v += a h for the skeleton
 // masses and rdot += a_r h for the envelope masses (their accelerations projected on
-// their half-lines).
-void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Vec3f& gravity,
-                                const Wind& wind, float h);
+// their half-lines). head_rot: the head's rotation (rest directions of pinned parts).
+void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                                const Vec3f& gravity, const Wind& wind, float h);
 
 // §5.1 step 4: x += v h for the skeleton, root to tip, then the new section frames, then
 // r += rdot h for the envelope (kept within 0.25 and 2 times its rest radius).
@@ -172,13 +175,25 @@ struct BodyStep {
 // of, and applies the penetration reaction root to tip: a skeleton mass inside is moved
 // out to 0.9 threshold above the surface ("slightly under the sliding contact
 // threshold"); then, with the frames rebuilt, an envelope mass inside is moved along its
-// half-line onto the surface. A moved mass loses its velocity into the body.
+// half-line onto the surface. A moved mass loses its velocity into the body. Expects
+// the section frames of the current skeleton (wisp_positions builds them), and rebuilds
+// them only if a skeleton mass moved.
 void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const Vec3f& root_e1, float threshold);
 
+// Between detections, an envelope mass the last detection found in contact with a body
+// stays out of it: where its half-line now enters the sphere nearer than the mass, the
+// mass is held at the entry point (no nearer than the radius floor) and its outward
+// radial rate, which would carry it in, is removed. Run after every position update, so
+// each correction is one step's worth of motion: an inelastic wall. Corrected only at the
+// detections, the radial spring drove the mass a period's worth into the head, and the
+// reaction's jump back re-compressed the spring 120 times a second (see wisp_body_slide).
+void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body);
+
 // Sliding contact (§4.2, a velocity modification) for the masses recorded by the last
-// detection: the relative velocity approaching the surface is removed and the
-// tangential one reduced by the fraction `drag` (viscous friction over the detection
-// period); envelope masses only along their half-lines (§5.1).
+// detection, on every integration step until the next one: the relative velocity
+// approaching the surface is removed and the tangential one reduced by the fraction
+// `drag` (viscous friction over the step); envelope masses only along their half-lines
+// (§5.1).
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag);
 
 // ---- Wisp-wisp interactions (§4.1) --------------------------------------------------

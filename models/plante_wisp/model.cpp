@@ -4,6 +4,7 @@
 #include "models/plante_wisp/settings.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -221,20 +222,56 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   chunk_contacts_.assign(static_cast<std::size_t>(chunks), {});
   chunk_mailbox_.assign(static_cast<std::size_t>(chunks), {});
   contacts_.clear();
+  contacts_known_ = false;
   pos_ = rest.positions;
   rebuild(Affine3f::Identity());
 }
 
+// Stage times inside a fused pass (issue 10): every kTimingSample-th wisp is timed stage
+// by stage, and the pass's measured time is split between the stages in those
+// proportions (as the fused Han kernel samples its blocks).
+constexpr std::size_t kTimingSample = 8;
+
+void PlanteWispModel::WispClock::lap(int stage) {
+  if (!on) return;
+  const auto now = std::chrono::steady_clock::now();
+  sampled_ns[stage]->fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(now - last).count(),
+                               std::memory_order_relaxed);
+  last = now;
+}
+
 template <class F>
-void PlanteWispModel::for_each_wisp(F&& f) {
+void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
+  for (auto& ns : sampled_ns_) ns.store(0, std::memory_order_relaxed);
   const std::size_t n = sys_.wisp_count();
   auto body = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t w = begin; w < end; ++w) f(w);
+    WispClock clock;
+    clock.sampled_ns = {&sampled_ns_[0], &sampled_ns_[1]};
+    for (std::size_t w = begin; w < end; ++w) {
+      clock.on = w % kTimingSample == 0;
+      if (clock.on) clock.last = std::chrono::steady_clock::now();
+      f(w, clock);
+    }
   };
+  const auto start = std::chrono::steady_clock::now();
+  // Static partition (ThreadPool::parallel_for): each wisp's result does not depend on
+  // which thread runs it.
   if (ctx_.pool && n >= static_cast<std::size_t>(threads_min_wisps_))
     ctx_.pool->parallel_for(n, body);
   else
     body(0, n);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double integration = static_cast<double>(sampled_ns_[kIntegration].load(std::memory_order_relaxed));
+  const double bodies = static_cast<double>(sampled_ns_[kBody].load(std::memory_order_relaxed));
+  const double share = integration + bodies > 0.0 ? bodies / (integration + bodies) : 0.0;
+  times.add("integration", ms * (1.0 - share));
+  if (bodies > 0.0) times.add("body_collision", ms * share);
+}
+
+std::size_t PlanteWispModel::state_bytes() const {
+  auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  return bytes(sys_.x) + bytes(sys_.v) + bytes(sys_.acc) + bytes(sys_.e1) + bytes(sys_.e2) + bytes(sys_.n) +
+         bytes(sys_.r) + bytes(sys_.rdot) + bytes(sys_.racc) + bytes(pos_);
 }
 
 void PlanteWispModel::detect_self_interactions() {
@@ -283,27 +320,23 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
   Affine3f head_before = in.head_prev;
   for (int i = 1; i <= steps; ++i) {
     const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(steps));
+    const Eigen::Matrix3f head_rot = head.linear();
+    // Bodies (§4.2): a mass the last detection found within the contact threshold is in
+    // sliding contact until the next detection, so the modification (approach removed,
+    // tangential slip dragged) applies on every integration step in between, not only on
+    // the detecting one. Applied once per detection, the masses sank into the body again
+    // between detections under gravity and their springs, and the penetration reaction
+    // threw them back out: on `idle` the position jumps re-loaded the stiff axial springs
+    // 120 times a second and held the hair in a 0.4 m/s jitter that never settled.
+    const bool body_on = collision_hz_ > 0.0 && body_pass;
+    // Also on the first step after reset: the sliding contacts above hold until the next
+    // detection, and a groom that starts inside a body would otherwise sink into it for
+    // a whole period before its first detection (the stress test's `inside_collider`:
+    // the wisps wrapped round the sphere from 8 ms deep, rebuilt strands 55% long).
+    const bool body_due = body_on && (crosses(collision_hz_, i) || i == steps || !contacts_known_);
+    contacts_known_ = contacts_known_ || body_due;
     k::BodyStep body;
-    {
-      StageTimer t(times, "integration");
-      for_each_wisp([&](std::size_t w) {
-        k::wisp_pin(sys_, w, head, h);
-        k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], in.gravity, in.wind, h);
-      });
-    }
-    // (2) + (3): wisp-wisp contacts are detected and responded to at the interaction
-    // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
-    // the time step").
-    if (crosses(interaction_hz_, i)) {
-      StageTimer t(times, "self_interaction");
-      detect_self_interactions();
-      k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
-    }
-    // Bodies: sliding contact for the masses the last body detection found near them,
-    // on the steps that detect (the position reaction follows the position update).
-    const bool body_due = collision_hz_ > 0.0 && body_pass && (crosses(collision_hz_, i) || i == steps);
-    if (body_due) {
-      StageTimer t(times, "body_collision");
+    if (body_on) {
       spheres_.clear();
       sphere_moves_.clear();
       for (const Sphere& c : in.colliders) {
@@ -315,18 +348,53 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       body.moves = sphere_moves_;
       body.motion = head * head_before.inverse();
       body.h = h;
-      const float period = static_cast<float>(std::min(1.0 / collision_hz_, in.dt));
-      const float drag = std::min(1.0f, interaction_.body_friction * period);
-      for_each_wisp([&](std::size_t w) { k::wisp_body_slide(sys_, w, body, drag); });
     }
-    {
-      StageTimer t(times, "integration");
-      for_each_wisp([&](std::size_t w) { k::wisp_positions(sys_, w, head.linear() * sys_.rest_e1[w], h); });
-    }
-    if (body_due) {
-      StageTimer t(times, "body_collision");
-      for_each_wisp([&](std::size_t w) {
-        k::wisp_body_detect(sys_, w, body, head.linear() * sys_.rest_e1[w], interaction_.contact_threshold);
+    // Viscous friction over this step.
+    const float drag = std::min(1.0f, interaction_.body_friction * h);
+    // §5.1 per wisp, root to tip inside the kernels: (1) forces and (3) velocities, the
+    // bodies' velocity modifications, then (4) positions and the bodies' position
+    // modifications. A wisp's stages touch only its own masses, so each wisp goes through
+    // them in one pass while it is in cache; the wisp-wisp response, which reads every
+    // wisp, splits the pass in two on the steps that detect. Same operations in the same
+    // order per wisp as plante_wisp_ref: bit-identical.
+    auto velocities = [&](std::size_t w, WispClock& clock) {
+      k::wisp_pin(sys_, w, head, h);
+      k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head_rot, in.gravity, in.wind, h);
+      clock.lap(kIntegration);
+      if (body_on) {
+        k::wisp_body_slide(sys_, w, body, drag);
+        clock.lap(kBody);
+      }
+    };
+    auto positions = [&](std::size_t w, WispClock& clock) {
+      const Vec3f root_e1 = head_rot * sys_.rest_e1[w];
+      k::wisp_positions(sys_, w, root_e1, h);
+      clock.lap(kIntegration);
+      if (body_on) {
+        k::wisp_body_hold(sys_, w, body);
+        if (body_due) k::wisp_body_detect(sys_, w, body, root_e1, interaction_.contact_threshold);
+        clock.lap(kBody);
+      }
+    };
+    // (2) + (3): wisp-wisp contacts are detected and responded to at the interaction
+    // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
+    // the time step"). After the bodies' modifications: a mass pressed against the head
+    // carries, after the force update, the step's worth of velocity into it (a h) that
+    // the sliding contact removes; seen by this response, it was handed on to the wisps
+    // touching that mass, and kept those on `idle` moving at up to 2 cm/s, 24 times a
+    // second.
+    if (crosses(interaction_hz_, i)) {
+      wisp_pass(times, velocities);
+      {
+        StageTimer t(times, "self_interaction");
+        detect_self_interactions();
+        k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
+      }
+      wisp_pass(times, positions);
+    } else {
+      wisp_pass(times, [&](std::size_t w, WispClock& clock) {
+        velocities(w, clock);
+        positions(w, clock);
       });
     }
     head_before = head;

@@ -11,6 +11,9 @@
 #include "kernels/cpu/wisp_grid.h"
 #include "kernels/cpu/wisp_kernels.h"
 
+#include <array>
+#include <atomic>
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -23,6 +26,9 @@ class PlanteWispModel final : public HairModel {
   // Stages: "integration", "body_collision", "self_interaction", "rebuild".
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
+  // What a step reads and writes: the skeleton's and envelope's state and forces, the
+  // section frames, and the rebuilt strands.
+  std::size_t state_bytes() const override;
 
   // The simulation state, for tests and inspection. Tests may edit velocities.
   const kernels::WispSystem& wisps() const { return sys_; }
@@ -39,8 +45,17 @@ class PlanteWispModel final : public HairModel {
 
  private:
   void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max);
+  // The stages a fused pass over the wisps times (see wisp_pass).
+  enum PassStage { kIntegration = 0, kBody = 1 };
+  struct WispClock {
+    bool on = false;
+    std::chrono::steady_clock::time_point last;
+    std::array<std::atomic<std::int64_t>*, 2> sampled_ns{};
+    void lap(int stage);  // time since the last lap to `stage`, on sampled wisps
+  };
+  // f(w, clock) for every wisp, over the threads; adds the pass's time to the stages.
   template <class F>
-  void for_each_wisp(F&& f);
+  void wisp_pass(StageTimes& times, F&& f);
   void detect_self_interactions();
 
   ModelContext ctx_;
@@ -62,8 +77,10 @@ class PlanteWispModel final : public HairModel {
   std::vector<std::vector<kernels::WispContact>> chunk_contacts_;
   std::vector<std::vector<std::uint32_t>> chunk_mailbox_;
   std::vector<kernels::WispContact> contacts_;
+  bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
+  std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};
 };
 
 std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx);

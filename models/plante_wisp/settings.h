@@ -5,8 +5,10 @@
 // equal integration steps; a detection runs on the step that crosses a multiple of its
 // period, and body collisions also on a frame's last step, so that no mass ends a frame
 // inside a body (the harness measures after each frame). A rate of 0 switches that
-// interaction off. The contacts a detection finds get their velocity modifications
-// (§5.1 step 3) in that step; the viscous drags stand for the detection period.
+// interaction off. The wisp-wisp contacts a detection finds get their velocity
+// modifications (§5.1 step 3) in that step, their drag standing for the detection
+// period; a body contact is a sliding contact until the next body detection and is
+// modified on every step in between (models/plante_wisp/model.cpp).
 //
 // Stiffnesses are accelerations per metre (1/s^2) of the mass they act on, dampings
 // 1/s: the defaults keep the explicit integration stable at 1000 Hz with the highest

@@ -1,0 +1,439 @@
+#include "models/plante_wisp_ref/model.h"
+
+#include "core/parallel.h"
+#include "models/plante_wisp/settings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+
+namespace hairbench::plante_ref {
+
+namespace k = hairbench::plante_ref;
+
+PlanteWispRefModel::PlanteWispRefModel(const ModelContext& ctx) : ctx_(ctx) {}
+
+namespace {
+
+Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
+
+// Squared distance between a rest strand and a cluster centre of equal vertex count:
+// the root weighs as much as the rest of the strand together, so wisps stay compact at
+// the scalp, where the strands are pinned and the rebuild cannot bend them apart.
+float strand_distance2(const Groom& g, std::uint32_t s, const std::vector<Vec3f>& centre, std::size_t j, std::size_t n) {
+  const std::uint32_t b = g.strand_begin(s);
+  float d = static_cast<float>(n) * (xyz(g.positions[b]) - centre[j * n]).squaredNorm();
+  for (std::size_t i = 1; i < n; ++i) d += (xyz(g.positions[b + i]) - centre[j * n + i]).squaredNorm();
+  return d;
+}
+
+// k-means with a fixed start (every (size/k)-th strand of the group) and a fixed number
+// of rounds: the same groom always gives the same wisps. Strands are compared over all
+// their rest vertices, not the root alone: near the crown, neighbouring roots comb
+// apart in every direction, and a wisp must hold strands that stay together (§3.1:
+// "neighboring hair strands of similar orientations"). Elsewhere the root dominates.
+std::vector<std::vector<std::uint32_t>> kmeans_strands(const Groom& g, const std::vector<std::uint32_t>& strands,
+                                                       std::size_t k) {
+  const std::size_t count = strands.size();
+  const std::size_t n = g.strand_size(strands[0]);
+  k = std::clamp<std::size_t>(k, 1, count);
+  std::vector<Vec3f> centre(k * n);
+  for (std::size_t j = 0; j < k; ++j) {
+    const std::uint32_t b = g.strand_begin(strands[(2 * j + 1) * count / (2 * k)]);
+    for (std::size_t i = 0; i < n; ++i) centre[j * n + i] = xyz(g.positions[b + i]);
+  }
+  std::vector<std::uint32_t> label(count, 0);
+  std::vector<Vec3f> sum(k * n);
+  std::vector<int> size(k);
+  constexpr int kRounds = 12;
+  for (int round = 0; round < kRounds; ++round) {
+    for (std::size_t i = 0; i < count; ++i) {
+      float best = std::numeric_limits<float>::infinity();
+      for (std::size_t j = 0; j < k; ++j) {
+        const float d = strand_distance2(g, strands[i], centre, j, n);
+        if (d < best) {
+          best = d;
+          label[i] = static_cast<std::uint32_t>(j);
+        }
+      }
+    }
+    std::fill(sum.begin(), sum.end(), Vec3f::Zero());
+    std::fill(size.begin(), size.end(), 0);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t b = g.strand_begin(strands[i]);
+      for (std::size_t v = 0; v < n; ++v) sum[label[i] * n + v] += xyz(g.positions[b + v]);
+      ++size[label[i]];
+    }
+    for (std::size_t j = 0; j < k; ++j)
+      if (size[j] > 0)
+        for (std::size_t v = 0; v < n; ++v) centre[j * n + v] = sum[j * n + v] / static_cast<float>(size[j]);
+  }
+  std::vector<std::vector<std::uint32_t>> out(k);
+  for (std::size_t i = 0; i < count; ++i) out[label[i]].push_back(strands[i]);
+  std::erase_if(out, [](const auto& c) { return c.empty(); });
+  return out;
+}
+
+// Widest distance of a cluster's strands from their mean curve, over all vertices.
+float cluster_width(const Groom& g, const std::vector<std::uint32_t>& c) {
+  const std::size_t n = g.strand_size(c[0]);
+  float widest = 0.0f;
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3f mean = Vec3f::Zero();
+    for (std::uint32_t s : c) mean += xyz(g.positions[g.strand_begin(s) + i]);
+    mean /= static_cast<float>(c.size());
+    for (std::uint32_t s : c) widest = std::max(widest, (xyz(g.positions[g.strand_begin(s) + i]) - mean).norm());
+  }
+  return widest;
+}
+
+// Mean rest edge length of a cluster's strands.
+float cluster_edge(const Groom& g, const std::vector<std::uint32_t>& c) {
+  double sum = 0.0;
+  std::size_t edges = 0;
+  for (std::uint32_t s : c)
+    for (std::uint32_t i = g.strand_begin(s) + 1; i < g.strand_begin(s) + g.strand_size(s); ++i, ++edges)
+      sum += (xyz(g.positions[i]) - xyz(g.positions[i - 1])).norm();
+  return edges ? static_cast<float>(sum / static_cast<double>(edges)) : 0.0f;
+}
+
+}  // namespace
+
+void PlanteWispRefModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max) {
+  // Wisps only gather strands of one region (they share its parameters) and of one
+  // vertex count (a wisp's nodes are its strands' vertices).
+  std::map<std::pair<std::uint16_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
+  for (std::size_t s = 0; s < rest.strand_count(); ++s)
+    groups[{rest.strand_region[s], rest.strand_size(s)}].push_back(static_cast<std::uint32_t>(s));
+  const double total = static_cast<double>(rest.strand_count());
+  sys_ = {};
+  strand_wisp_.assign(rest.strand_count(), 0);
+  std::vector<Vec3f> rest_x;
+  std::vector<std::vector<std::uint32_t>> members;
+  for (const auto& [key, strands] : groups) {
+    const double share = static_cast<double>(strands.size());
+    const double want = wisps > 0 ? wisps * share / total : share / strands_per_wisp;
+    // A wisp's strands keep fixed offsets in its sections (§5.2), so a section turning
+    // by an angle moves them axially by up to the wisp's radius times that angle: an edge
+    // of a strand at radius r across a node whose bend changes by phi changes by about
+    // 2 r tan(phi/2). Wisps wider than `width_max` rest edges (from their strands' mean
+    // curve) are split in two until none is; the paper's wisps are "mostly as wide as
+    // they are long" (§4.1, footnote 1), i.e. r up to half a segment.
+    std::vector<std::vector<std::uint32_t>> todo =
+        kmeans_strands(rest, strands, static_cast<std::size_t>(std::max(1.0, std::round(want))));
+    std::vector<std::vector<std::uint32_t>> clusters;
+    while (!todo.empty()) {
+      std::vector<std::uint32_t> c = std::move(todo.back());
+      todo.pop_back();
+      auto halves = c.size() > 1 && cluster_width(rest, c) > width_max * cluster_edge(rest, c)
+                        ? kmeans_strands(rest, c, 2)
+                        : std::vector<std::vector<std::uint32_t>>{};
+      if (halves.size() == 2) {
+        for (auto& half : halves) todo.push_back(std::move(half));
+      } else {
+        clusters.push_back(std::move(c));  // narrow enough, or strands k-means cannot part
+      }
+    }
+    std::sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) { return a.front() < b.front(); });
+    for (auto& c : clusters) {
+      const std::uint32_t n = key.second;
+      for (std::uint32_t i = 0; i < n; ++i) {
+        Vec3f mean = Vec3f::Zero();
+        bool pinned = true;
+        for (std::uint32_t s : c) {
+          const Vec4f& p = rest.positions[rest.strand_begin(s) + i];
+          mean += xyz(p);
+          pinned = pinned && p.w() == 0.0f;
+        }
+        sys_.rest_x.push_back(mean / static_cast<float>(c.size()));
+        sys_.pinned.push_back(pinned ? 1 : 0);
+      }
+      for (std::uint32_t s : c) strand_wisp_[s] = static_cast<std::uint32_t>(members.size());
+      sys_.node_begin.push_back(static_cast<std::uint32_t>(sys_.rest_x.size()));
+      sys_.wisp_params.push_back(key.first);
+      members.push_back(std::move(c));
+    }
+  }
+  sys_.r_rest.assign(sys_.rest_x.size(), 0.0f);
+  sys_.resize_state();
+  for (std::size_t w = 0; w < sys_.wisp_count(); ++w) k::wisp_init_rest(sys_, w, root_blend);
+
+  // §3.4/§5.2: each strand vertex gets fixed coordinates in its wisp's sections
+  // (plante_ref::strand_coord). A section's rest radius is the circle holding every strand
+  // point interpolated from it (§5.2: points "in a circle"), so strands start inside.
+  coord_.assign(rest.vertex_count(), Vec4f::Zero());
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    const std::uint32_t w = strand_wisp_[s];
+    for (std::uint32_t i = 0; i < rest.strand_size(s); ++i) {
+      const std::uint32_t node = sys_.node_begin[w] + i;
+      const Vec4f c = k::strand_coord(sys_, w, node, xyz(rest.positions[rest.strand_begin(s) + i]), Eigen::Matrix3f::Identity());
+      coord_[rest.strand_begin(s) + i] = c;
+      const float radius = std::hypot(c.y(), c.z());
+      sys_.r_rest[node] = std::max(sys_.r_rest[node], radius);
+      if (c.x() != 0.0f) {
+        const std::uint32_t j = c.x() > 0.0f ? node + 1 : node - 1;
+        sys_.r_rest[j] = std::max(sys_.r_rest[j], radius);
+      }
+    }
+  }
+}
+
+void PlanteWispRefModel::reset(const Groom& rest, const ParamSet& params) {
+  rest_ = rest;
+  sleep_.reset(1);
+  params_.clear();
+  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
+    k::WispParams p;
+    auto f = [&](const char* name) { return static_cast<float>(params.get(name, r)); };
+    p.air_drag = f("air_drag");
+    p.axial_stiffness = f("axial_stiffness");
+    p.axial_damping = f("axial_damping");
+    p.bending_stiffness = f("bending_stiffness");
+    p.bending_damping = f("bending_damping");
+    p.envelope_mass = f("envelope_mass");
+    p.radial_stiffness = f("radial_stiffness");
+    p.radial_stretch = f("radial_stretch");
+    p.radial_damping = f("radial_damping");
+    p.ring_stiffness = f("ring_stiffness");
+    p.ring_damping = f("ring_damping");
+    params_.push_back(p);
+  }
+  const double deg = std::numbers::pi / 180.0;
+  interaction_.contact_threshold = static_cast<float>(params.get("contact_threshold"));
+  interaction_.body_friction = static_cast<float>(params.get("body_friction"));
+  interaction_.hair_friction = static_cast<float>(params.get("hair_friction"));
+  interaction_.parallel_cos = static_cast<float>(std::cos(params.get("parallel_angle") * deg));
+  interaction_.in_plane_sin = static_cast<float>(std::sin(params.get("in_plane_angle") * deg));
+  integration_hz_ = params.get("integration_hz");
+  collision_hz_ = params.get("collision_hz");
+  interaction_hz_ = params.get("interaction_hz");
+  threads_min_wisps_ = params.get_int("threads_min_wisps");
+
+  cluster(rest, params.get_int("wisps"), params.get_int("strands_per_wisp"), params.get_int("root_blend"),
+          static_cast<float>(params.get("wisp_width_max")));
+  const float r_min = static_cast<float>(params.get("wisp_radius_min"));
+  for (float& r : sys_.r_rest) r = std::max(r, r_min);
+  for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
+
+  const int chunks = ctx_.pool ? ctx_.pool->threads() : 1;
+  chunk_contacts_.assign(static_cast<std::size_t>(chunks), {});
+  chunk_mailbox_.assign(static_cast<std::size_t>(chunks), {});
+  contacts_.clear();
+  contacts_known_ = false;
+  pos_ = rest.positions;
+  rebuild(Affine3f::Identity());
+}
+
+template <class F>
+void PlanteWispRefModel::for_each_wisp(F&& f) {
+  const std::size_t n = sys_.wisp_count();
+  auto body = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t w = begin; w < end; ++w) f(w);
+  };
+  if (ctx_.pool && n >= static_cast<std::size_t>(threads_min_wisps_))
+    ctx_.pool->parallel_for(n, body);
+  else
+    body(0, n);
+}
+
+std::size_t PlanteWispRefModel::state_bytes() const {
+  auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  return bytes(sys_.x) + bytes(sys_.v) + bytes(sys_.acc) + bytes(sys_.e1) + bytes(sys_.e2) + bytes(sys_.n) +
+         bytes(sys_.r) + bytes(sys_.rdot) + bytes(sys_.racc) + bytes(pos_);
+}
+
+void PlanteWispRefModel::detect_self_interactions() {
+  k::grid_build(grid_, sys_);
+  const std::size_t n = grid_.size(), chunks = chunk_contacts_.size();
+  auto run = [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c) {
+      chunk_contacts_[c].clear();
+      chunk_mailbox_[c].assign(n, std::numeric_limits<std::uint32_t>::max());
+      k::grid_contacts(grid_, sys_, n * c / chunks, n * (c + 1) / chunks, chunk_mailbox_[c], chunk_contacts_[c]);
+    }
+  };
+  if (ctx_.pool && chunks > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
+    ctx_.pool->parallel_for(chunks, run);
+  else
+    run(0, chunks);
+  // Chunks are contiguous ranges of segments: concatenated in order they are the serial
+  // list, whatever the thread count.
+  contacts_.clear();
+  for (const auto& c : chunk_contacts_) contacts_.insert(contacts_.end(), c.begin(), c.end());
+}
+
+// §5.1, once per integration step: (1) forces, (2) interaction detection at its rate,
+// (3) velocities then their modifications, (4) positions then their modifications;
+// skeleton before envelope, root to tip (inside the kernels).
+void PlanteWispRefModel::step(const FrameInput& in, StageTimes& times) {
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    for (std::string_view stage : {"integration", "body_collision", "self_interaction", "rebuild"}) times.skip(stage);
+    return;
+  }
+  // Issue 8: without colliders there is no body pass at all, and the report says so;
+  // --no-skip runs the pass over no spheres.
+  const bool body_pass = !in.colliders.empty() || !ctx_.skip_inert;
+  if (!body_pass) times.skip("body_collision");
+  const int steps = std::max(1, static_cast<int>(std::ceil(in.dt * integration_hz_ - 1e-9)));
+  const float h = static_cast<float>(in.dt / steps);
+  const double t0 = in.t - in.dt;
+  auto crosses = [&](double rate, int i) {
+    // The epsilon keeps a period boundary that falls on a step's end (in exact
+    // arithmetic) on that step despite rounding.
+    constexpr double kEps = 1e-9;
+    return rate > 0.0 && std::floor((t0 + i * (in.dt / steps)) * rate + kEps) >
+                             std::floor((t0 + (i - 1) * (in.dt / steps)) * rate + kEps);
+  };
+  Affine3f head_before = in.head_prev;
+  for (int i = 1; i <= steps; ++i) {
+    const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(steps));
+    k::BodyStep body;
+    {
+      StageTimer t(times, "integration");
+      for_each_wisp([&](std::size_t w) {
+        k::wisp_pin(sys_, w, head, h);
+        k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head.linear(), in.gravity, in.wind, h);
+      });
+    }
+    // Bodies (§4.2): a mass the last detection found within the contact threshold is in
+    // sliding contact until the next detection, so the modification (approach removed,
+    // tangential slip dragged) applies on every integration step in between, not only on
+    // the detecting one. Applied once per detection, the masses sank into the body again
+    // between detections under gravity and their springs, and the penetration reaction
+    // threw them back out: on `idle` the position jumps re-loaded the stiff axial springs
+    // 120 times a second and held the hair in a 0.4 m/s jitter that never settled.
+    const bool body_on = collision_hz_ > 0.0 && body_pass;
+    // Also on the first step after reset: the sliding contacts above hold until the next
+    // detection, and a groom that starts inside a body would otherwise sink into it for
+    // a whole period before its first detection (the stress test's `inside_collider`:
+    // the wisps wrapped round the sphere from 8 ms deep, rebuilt strands 55% long).
+    const bool body_due = body_on && (crosses(collision_hz_, i) || i == steps || !contacts_known_);
+    contacts_known_ = contacts_known_ || body_due;
+    if (body_on) {
+      StageTimer t(times, "body_collision");
+      spheres_.clear();
+      sphere_moves_.clear();
+      for (const Sphere& c : in.colliders) {
+        const Vec3f centre = collider_center(c, head);
+        spheres_.emplace_back(centre.x(), centre.y(), centre.z(), c.radius);
+        sphere_moves_.push_back(c.head_attached ? 1 : 0);
+      }
+      body.spheres = spheres_;
+      body.moves = sphere_moves_;
+      body.motion = head * head_before.inverse();
+      body.h = h;
+      // Viscous friction over this step.
+      const float drag = std::min(1.0f, interaction_.body_friction * h);
+      for_each_wisp([&](std::size_t w) { k::wisp_body_slide(sys_, w, body, drag); });
+    }
+    // (2) + (3): wisp-wisp contacts are detected and responded to at the interaction
+    // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
+    // the time step"). After the bodies' modifications: a mass pressed against the head
+    // carries, after the force update, the step's worth of velocity into it (a h) that
+    // the sliding contact removes; seen by this response, it was handed on to the wisps
+    // touching that mass, and kept those on `idle` moving at up to 2 cm/s, 24 times a
+    // second.
+    if (crosses(interaction_hz_, i)) {
+      StageTimer t(times, "self_interaction");
+      detect_self_interactions();
+      k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
+    }
+    {
+      StageTimer t(times, "integration");
+      for_each_wisp([&](std::size_t w) { k::wisp_positions(sys_, w, head.linear() * sys_.rest_e1[w], h); });
+    }
+    if (body_on) {
+      StageTimer t(times, "body_collision");
+      for_each_wisp([&](std::size_t w) { k::wisp_body_hold(sys_, w, body); });
+    }
+    if (body_due) {
+      StageTimer t(times, "body_collision");
+      for_each_wisp([&](std::size_t w) {
+        k::wisp_body_detect(sys_, w, body, head.linear() * sys_.rest_e1[w], interaction_.contact_threshold);
+      });
+    }
+    head_before = head;
+  }
+  {
+    StageTimer t(times, "rebuild");
+    rebuild(in.head);
+  }
+  if (calm) {
+    // The fastest skeleton mass or envelope mass (along its half-line) decides.
+    float speed2 = 0.0f;
+    for (const Vec3f& v : sys_.v) speed2 = std::max(speed2, v.squaredNorm());
+    for (float rd : sys_.rdot) speed2 = std::max(speed2, rd * rd);
+    sleep_.observe_speed(0, std::sqrt(speed2));
+    sleep_.end_observe();
+  }
+}
+
+// §5.2: the strands are drawn at fixed positions relative to the wisp envelope: the
+// section's origin is the skeleton, its axes and scale factors come from the four
+// envelope masses (plante_ref::strand_point).
+//
+// A strand's pinned vertices follow the head, but they lie up to half a segment ahead of
+// or behind the wisp's pinned nodes along its axis (the wisp's nodes are its strands'
+// mean vertices): when the wisp's first free segment turns by an angle about its pinned
+// node, the section point of a pinned vertex turns with it while the vertex does not,
+// and the first free edge changed length by up to half a segment times that angle
+// (0.5-1.4 of its rest length on ponytail, spin_fast, tilt_upside_down, wind_gust).
+// The gap between the last pinned vertex and its section point (`anchor`) is carried
+// by the free vertices, fading with the section weight that already blends the axes
+// near the root (root_blend), so the strand stays attached to its root.
+void PlanteWispRefModel::rebuild(const Affine3f& head) {
+  const Eigen::Matrix3f head_rot = head.linear();
+  auto body = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t nb = sys_.node_begin[strand_wisp_[s]];
+      const std::uint32_t vb = rest_.strand_begin(s);
+      const std::uint32_t n = rest_.strand_size(s);
+      auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
+      auto point = [&](std::uint32_t i) { return k::strand_point(sys_, nb + i, coord_[vb + i], head_rot); };
+      // Root to tip, each free vertex anchored to the last pinned one before it ...
+      Vec3f anchor = Vec3f::Zero();
+      int last = -1;
+      bool pinned_after_free = false;
+      for (std::uint32_t i = 0; i < n; ++i) {
+        Vec4f& out = pos_[vb + i];
+        if (pinned(i)) {
+          out.head<3>() = head * xyz(rest_.positions[vb + i]);
+          anchor = xyz(out) - point(i);
+          pinned_after_free = pinned_after_free || (last >= 0 && static_cast<std::uint32_t>(last) + 1 < i) ||
+                              (last < 0 && i > 0);
+          last = static_cast<int>(i);
+          continue;
+        }
+        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
+        out.head<3>() = point(i) + (1.0f - wgt) * anchor;
+      }
+      if (!pinned_after_free) continue;
+      // ... or, where a pinned vertex follows nearer (a strand pinned at both ends), to it.
+      int next = -1;
+      for (std::uint32_t i = n; i-- > 0;) {
+        if (pinned(i)) {
+          anchor = xyz(pos_[vb + i]) - point(i);
+          next = static_cast<int>(i);
+          continue;
+        }
+        if (next < 0) continue;
+        int prev = static_cast<int>(i) - 1;
+        while (prev >= 0 && !pinned(static_cast<std::uint32_t>(prev))) --prev;
+        if (prev >= 0 && static_cast<int>(i) - prev <= next - static_cast<int>(i)) continue;
+        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
+        pos_[vb + i].head<3>() = point(i) + (1.0f - wgt) * anchor;
+      }
+    }
+  };
+  if (ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
+    ctx_.pool->parallel_for(rest_.strand_count(), body);
+  else
+    body(0, rest_.strand_count());
+}
+
+std::unique_ptr<HairModel> make_plante_wisp_ref(const ModelContext& ctx) { return std::make_unique<PlanteWispRefModel>(ctx); }
+
+}  // namespace hairbench::plante_ref

@@ -1,0 +1,228 @@
+// plante_wisp_ref: plante_wisp as it stood before the issue-10 speed work (one pass per
+// stage over all wisps, a parallel_for per stage, the per-wisp kernels unchanged), kept
+// as the reference that plante_wisp's speed-up and agreement are measured against
+// (tests/plante_test.cpp, hairbench_bench BM_step). Physics: models/plante_wisp.
+// The layered wisp model of Plante, Cani & Poulin 2001 (§3-§5) as plain arrays and pure
+// per-wisp functions: skeleton point masses (§3.2), envelope masses on half-lines of the
+// cross-sections (§3.3), and the velocity/position modifications of the interactions
+// (§4). The model adapter (models/plante_wisp) owns the loop of §5.1 and the rates.
+//
+// Units: every force is an acceleration of the mass it acts on (skeleton masses are 1,
+// envelope masses `envelope_mass`), stiffnesses are in 1/s^2, dampings in 1/s.
+#pragma once
+
+#include "core/types.h"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace hairbench::plante_ref {
+
+// Physical parameters of one wisp (one per groom region).
+struct WispParams {
+  float air_drag = 5.0f;            // 1/s, on every mass's absolute velocity (§5.1 "air resistance")
+  float axial_stiffness = 4e5f;     // 1/s^2 per metre of stretch (§3.2 linear axial springs)
+  float axial_damping = 40.0f;      // 1/s on the relative axial velocity
+  float bending_stiffness = 1e5f;   // 1/s^2: lateral acceleration = k * angle * rest length (§3.2)
+  float bending_damping = 60.0f;    // 1/s on the relative lateral velocity
+  float envelope_mass = 0.1f;       // envelope mass / skeleton mass (§3.3 "much lighter")
+  float radial_stiffness = 5e4f;    // 1/s^2, compression branch at small strain (§3.3)
+  float radial_stretch = 0.3f;      // stretch stiffness as a fraction of the compression one
+  float radial_damping = 300.0f;    // 1/s ("highly viscous" radial springs, §1 abstract)
+  float ring_stiffness = 1e4f;      // 1/s^2, soft springs between a section's envelope masses
+  float ring_damping = 200.0f;      // 1/s, "highly damped"
+};
+
+// Interaction parameters (§4), shared by all wisps.
+struct InteractionParams {
+  float contact_threshold = 0.002f;  // m, sliding contact distance to a body (§4.2)
+  float body_friction = 20.0f;       // 1/s, viscous tangential drag against a body (§4.2)
+  float hair_friction = 5.0f;        // 1/s at rest density, viscous drag between quasi-parallel wisps (§4.1)
+  float parallel_cos = 0.866f;       // cos of the widest angle between "quasi-parallel" wisps
+  float in_plane_sin = 0.5f;         // sin of the widest angle between v_rel and the wisps' plane
+};
+
+// The envelope masses of a section, in this order along the section's axes e1, e2.
+inline constexpr int kEnvelopePerSection = 4;  // §5.2: "we use only four envelope mass-points"
+
+// All wisps. Nodes of wisp w are [node_begin[w], node_begin[w+1]); node k's envelope
+// masses are 4k..4k+3 along +e1, +e2, -e1, -e2 of its section frame.
+struct WispSystem {
+  std::vector<std::uint32_t> node_begin{0};
+  std::vector<std::uint16_t> wisp_params;  // index into the params table, per wisp
+
+  // Skeleton (§3.2). Pinned nodes (the first segment, inside the head) follow the head.
+  std::vector<Vec3f> x, v, acc;   // acc: the force-driven acceleration of the last step
+  std::vector<Vec3f> rest_x;      // head rest frame
+  std::vector<std::uint8_t> pinned;
+  std::vector<float> rest_len;    // segment (k-1, k), stored at k (0 at a wisp's first node)
+  std::vector<Vec3f> bend_local;  // rest direction of segment (k-1, k) in frame k-2 turned onto segment (k-2, k-1)
+  // Section frames (§3.3): e1, e2 span the plane bisecting the adjacent segments, n its
+  // normal; propagated root to tip by minimal rotation from the head-attached root frame.
+  std::vector<Vec3f> e1, e2, n;
+  std::vector<Vec3f> rest_e1;     // per wisp: e1 of its first section, head rest frame
+  // Rest section frames (head rest frame), and per node the weight of the current
+  // section frame against the head-carried rest one in the strand rebuild (see
+  // strand_point): 0 on pinned nodes, ramping to 1 over the first free ones.
+  std::vector<Vec3f> rest_fe1, rest_fe2;
+  std::vector<float> frame_weight;
+  std::vector<std::uint32_t> node_wisp;
+
+  // Envelope (§3.3): radial coordinate along each half-line and its rate.
+  std::vector<float> r, rdot, racc;  // per envelope mass; racc: radial acceleration scratch
+  std::vector<float> r_rest;         // per node: sections are circles at rest
+
+  // Body contacts found at the last body-collision detection (sphere index, -1 none).
+  std::vector<std::int32_t> node_body, env_body;
+  // Per-mass velocity modification accumulators for the wisp-wisp response.
+  std::vector<Vec3f> node_dv;
+  std::vector<float> node_dv_weight, env_dr, env_dr_weight;
+
+  std::size_t wisp_count() const { return node_begin.size() - 1; }
+  std::size_t node_count() const { return x.size(); }
+  // Sizes every state array after node_begin, wisp_params, rest_x and pinned are filled;
+  // the state is the rest state (x = rest_x, still, envelope at rest radius r_rest).
+  void resize_state();
+};
+
+// Unit direction of envelope mass q of node k.
+inline Vec3f envelope_dir(const WispSystem& s, std::size_t k, int q) {
+  switch (q) {
+    case 0: return s.e1[k];
+    case 1: return s.e2[k];
+    case 2: return -s.e1[k];
+    default: return -s.e2[k];
+  }
+}
+inline Vec3f envelope_point(const WispSystem& s, std::size_t k, int q) {
+  return s.x[k] + s.r[4 * k + q] * envelope_dir(s, k, q);
+}
+
+// A strand vertex in its wisp (§3.4, §5.2), as coordinates (s, a, b, c) relative to
+// node k: the section it lies in is interpolated a fraction |s| of the way to node
+// k + sign(s) (origin, axes and envelope scale), (a, b) are its coordinates in that
+// section's plane, scaled on each half-axis by its envelope mass's radius over the rest
+// radius, and c a small offset along the section normal. Following the skeleton this
+// way, a strand whose vertices sit a little ahead of or behind the wisp's nodes still
+// bends with the wisp instead of swinging about the nodes' normals.
+//
+// Near the root the section axes (and the envelope's scale, towards 1) are blended
+// towards the head-carried rest axes (frame_weight): every strand is rooted at its own point of the scalp and bends there,
+// whereas a wide wisp's section swinging about the wisp's centre would carry the strand
+// offsets (up to the wisp's radius) through the same angle and stretch the first free
+// strand edges by up to radius x angle - more than the edge itself for a centimetre-wide
+// wisp swinging by a radian.
+Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& coord, const Eigen::Matrix3f& head_rot);
+// frame_weight interpolated like the section of strand_point at coordinate sfrac.
+float section_weight(const WispSystem& s, std::uint32_t k, float sfrac);
+// The coordinates of p relative to node k of wisp w in the current state, exact for
+// strand_point when the envelope is at its rest radii.
+Vec4f strand_coord(const WispSystem& s, std::size_t w, std::uint32_t k, const Vec3f& p,
+                   const Eigen::Matrix3f& head_rot);
+// Scale factors (current / rest radius) of the section interpolated like strand_point,
+// for the half-axes on the sides of a and b: the envelope's extent there is
+// r_rest-interpolated times this scale.
+struct SectionFrame {
+  Vec3f origin, e1, e2, n;
+  float scale_a[2], scale_b[2];  // [0]: +axis, [1]: -axis
+  float rest_radius;
+};
+SectionFrame section_frame(const WispSystem& s, std::uint32_t k, float sfrac, const Eigen::Matrix3f& head_rot);
+
+// Rotates v by the minimal rotation taking unit a to unit b (no twist about the axis).
+Vec3f minimal_rotate(const Vec3f& a, const Vec3f& b, const Vec3f& v);
+
+// Section frames of wisp w from its skeleton: n_k bisects the adjacent segments, e1 of
+// the first section is `root_e1` (head-attached), every other frame is the previous one
+// minimally rotated from n_{k-1} to n_k (§3.3).
+void wisp_frames(WispSystem& s, std::size_t w, const Vec3f& root_e1);
+
+// Rest data of wisp w from its rest skeleton (rest_x): rest lengths, frames, the rest
+// bending directions, and frame weights ramping from 0 to 1 over the `root_blend` free
+// nodes after the pinned ones.
+void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend);
+
+// Pinned nodes follow the head transform `head`; their velocities are the displacement
+// over the step h.
+void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h);
+
+// §5.1 steps 1 and 3 (before modifications): forces, then v += a h for the skeleton
+// masses and rdot += a_r h for the envelope masses (their accelerations projected on
+// their half-lines). head_rot: the head's rotation (rest directions of pinned parts).
+void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                                const Vec3f& gravity, const Wind& wind, float h);
+
+// §5.1 step 4: x += v h for the skeleton, root to tip, then the new section frames, then
+// r += rdot h for the envelope (kept within 0.25 and 2 times its rest radius).
+void wisp_positions(WispSystem& s, std::size_t w, const Vec3f& root_e1, float h);
+
+// ---- Wisp-body interactions (§4.2) -------------------------------------------------
+
+// Where the bodies are during one integration step: spheres (xyz centre, w radius,
+// world space), which of them move with the head, and the head's rigid motion over the
+// step (it carries a point on a head-attached sphere from where it was to where it is).
+struct BodyStep {
+  std::span<const Vec4f> spheres;
+  std::span<const std::uint8_t> moves;
+  Affine3f motion = Affine3f::Identity();
+  float h = 0.0f;
+  Vec3f surface_velocity(std::size_t i, const Vec3f& p) const {
+    return moves[i] ? Vec3f((motion * p - p) / h) : Vec3f::Zero();
+  }
+};
+
+// Detection on wisp w (§4.2): records which sphere each free mass is within `threshold`
+// of, and applies the penetration reaction root to tip: a skeleton mass inside is moved
+// out to 0.9 threshold above the surface ("slightly under the sliding contact
+// threshold"); then, with the frames rebuilt, an envelope mass inside is moved along its
+// half-line onto the surface. A moved mass loses its velocity into the body.
+void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const Vec3f& root_e1, float threshold);
+
+// Between detections, an envelope mass the last detection found in contact with a body
+// stays out of it: where its half-line now enters the sphere nearer than the mass, the
+// mass is held at the entry point (no nearer than the radius floor) and its outward
+// radial rate, which would carry it in, is removed. Run after every position update, so
+// each correction is one step's worth of motion: an inelastic wall. Corrected only at the
+// detections, the radial spring drove the mass a period's worth into the head, and the
+// reaction's jump back re-compressed the spring 120 times a second (see wisp_body_slide).
+void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body);
+
+// Sliding contact (§4.2, a velocity modification) for the masses recorded by the last
+// detection, on every integration step until the next one: the relative velocity
+// approaching the surface is removed and the tangential one reduced by the fraction
+// `drag` (viscous friction over the step); envelope masses only along their half-lines
+// (§5.1).
+void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag);
+
+// ---- Wisp-wisp interactions (§4.1) --------------------------------------------------
+
+// A point mass (skeleton node, or envelope mass 4k+q) found inside the volume of a wisp
+// segment (seg, seg+1) at axial parameter u.
+struct WispContact {
+  std::uint32_t point;   // node index, or envelope index when envelope != 0
+  std::uint32_t seg;     // first node of the segment
+  float u;
+  std::uint8_t envelope;
+};
+
+// Is p inside the volume of segment (a, a+1), bounded by its two sections? Returns u in
+// [0,1] when inside, a negative value otherwise. The volume is swept by the sections'
+// quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along the axis.
+float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p);
+
+// Narrow phase for one pair of segments whose bounding boxes overlap: the masses of each
+// segment tested against the other's volume (§4.1); appends contacts to out. A segment
+// (k-1, k) owns the masses of node k, so every free mass belongs to exactly one segment.
+void segment_pair_contacts(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vector<WispContact>& out);
+
+// The response of every contact from the current state (§4.1), accumulated then applied
+// as averages per mass: quasi-parallel wisps (orientations within acos(parallel_cos),
+// relative velocity within asin(in_plane_sin) of their common plane) lose the relative
+// velocity normal to that plane and get a viscous in-plane drag min(1, hair_friction *
+// density * h), h the period the response stands for; other contacts are inelastic collisions (relative velocity removed).
+// Splits are momentum-conserving: equal masses give the paper's halves.
+void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,
+                           std::span<const WispParams> params, float h);
+
+}  // namespace hairbench::plante_ref
