@@ -12,7 +12,6 @@
 #include "models/halen_spring/settings.h"
 #include "models/plante_wisp/model.h"
 #include "models/plante_wisp/settings.h"
-#include "models/plante_wisp_ref/model.h"
 #ifdef HAIRBENCH_HAS_VULKAN
 #include "models/han_vk/model.h"
 #endif
@@ -50,7 +49,7 @@ std::span<const ModelInfo> model_registry() {
       {"plante_wisp", "Plante, Cani & Poulin 2001: layered wisps (skeleton, envelope, strands) with anisotropic interactions (§3-5)",
        plante::kParams, [](const ModelContext& c) { return plante::make_plante_wisp(c); }},
       {"plante_wisp_ref", "plante_wisp one stage at a time over all wisps (the reference for plante_wisp)",
-       plante::kParams, [](const ModelContext& c) { return plante_ref::make_plante_wisp_ref(c); }},
+       plante::kParams, [](const ModelContext& c) { return plante::make_plante_wisp(c, plante::Schedule::PerStage); }},
 #ifdef HAIRBENCH_HAS_VULKAN
       {"han_m1_vk", "Han & Harada 2012 method 1 on a Vulkan device (§5: a workgroup per strand, shared memory)",
        han::kParams, [](const ModelContext& c) { return han_vk::make_han_vk(han::Method::Serial, c); },

@@ -343,8 +343,8 @@ TEST(PlanteWisp, DeterministicAcrossRunsAndThreads) {
   EXPECT_EQ(a[0].state_hash, c[0].state_hash);
 }
 
-// Issue 10: plante_wisp (one fused pass per wisp and step, cheaper rejections in the
-// narrow phase) performs plante_wisp_ref's floating-point operations in the same order,
+// Issue 10: plante_wisp (one fused pass per wisp and step) performs the per-stage
+// schedule's (plante_wisp_ref's) floating-point operations in the same order,
 // so the two agree bit for bit, frame by frame, through the whole shake and its stop
 // (head turning, body contacts, wisp-wisp contacts, sleeping at the end), on 1 and 2
 // threads, with the threads used from the first wisp on.

@@ -313,7 +313,9 @@ TEST(TressfxScenario, PonytailProjectStaysStableWithHanModels) {
         // plante_wisp collides its wisps' masses (tests/plante_test.cpp); its strands are
         // rebuilt inside the envelopes afterwards (§5.2) and may cut into a sphere
         // between two masses (5.4 mm here).
-        if (r.model != "plante_wisp") EXPECT_LT(test::max_of(r.penetration), 1e-3);
+        if (r.model != "plante_wisp") {
+          EXPECT_LT(test::max_of(r.penetration), 1e-3);
+        }
       }
     }
   }

@@ -14,7 +14,7 @@ namespace hairbench::plante {
 
 namespace k = hairbench::kernels;
 
-PlanteWispModel::PlanteWispModel(const ModelContext& ctx) : ctx_(ctx) {}
+PlanteWispModel::PlanteWispModel(const ModelContext& ctx, Schedule schedule) : ctx_(ctx), schedule_(schedule) {}
 
 namespace {
 
@@ -241,10 +241,21 @@ void PlanteWispModel::WispClock::lap(int stage) {
 }
 
 template <class F>
+void PlanteWispModel::for_each_wisp(F&& f) {
+  // Static partition (ThreadPool::parallel_for): each wisp's result does not depend on
+  // which thread runs it.
+  const std::size_t n = sys_.wisp_count();
+  if (ctx_.pool && n >= static_cast<std::size_t>(threads_min_wisps_))
+    ctx_.pool->parallel_for(n, [&](std::size_t begin, std::size_t end) { f(begin, end); });
+  else
+    f(std::size_t{0}, n);
+}
+
+template <class F>
 void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
   for (auto& ns : sampled_ns_) ns.store(0, std::memory_order_relaxed);
-  const std::size_t n = sys_.wisp_count();
-  auto body = [&](std::size_t begin, std::size_t end) {
+  const auto start = std::chrono::steady_clock::now();
+  for_each_wisp([&](std::size_t begin, std::size_t end) {
     WispClock clock;
     clock.sampled_ns = {&sampled_ns_[0], &sampled_ns_[1]};
     for (std::size_t w = begin; w < end; ++w) {
@@ -252,20 +263,21 @@ void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
       if (clock.on) clock.last = std::chrono::steady_clock::now();
       f(w, clock);
     }
-  };
-  const auto start = std::chrono::steady_clock::now();
-  // Static partition (ThreadPool::parallel_for): each wisp's result does not depend on
-  // which thread runs it.
-  if (ctx_.pool && n >= static_cast<std::size_t>(threads_min_wisps_))
-    ctx_.pool->parallel_for(n, body);
-  else
-    body(0, n);
+  });
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   const double integration = static_cast<double>(sampled_ns_[kIntegration].load(std::memory_order_relaxed));
   const double bodies = static_cast<double>(sampled_ns_[kBody].load(std::memory_order_relaxed));
   const double share = integration + bodies > 0.0 ? bodies / (integration + bodies) : 0.0;
   times.add("integration", ms * (1.0 - share));
   if (bodies > 0.0) times.add("body_collision", ms * share);
+}
+
+template <class F>
+void PlanteWispModel::stage_pass(StageTimes& times, std::string_view stage, F&& f) {
+  StageTimer t(times, stage);
+  for_each_wisp([&](std::size_t begin, std::size_t end) {
+    for (std::size_t w = begin; w < end; ++w) f(w);
+  });
 }
 
 std::size_t PlanteWispModel::state_bytes() const {
@@ -356,7 +368,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // modifications. A wisp's stages touch only its own masses, so each wisp goes through
     // them in one pass while it is in cache; the wisp-wisp response, which reads every
     // wisp, splits the pass in two on the steps that detect. Same operations in the same
-    // order per wisp as plante_wisp_ref: bit-identical.
+    // order per wisp as the per-stage schedule (plante_wisp_ref): bit-identical.
     auto velocities = [&](std::size_t w, WispClock& clock) {
       k::wisp_pin(sys_, w, head, h);
       k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head_rot, in.gravity, in.wind, h);
@@ -383,7 +395,28 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // the sliding contact removes; seen by this response, it was handed on to the wisps
     // touching that mass, and kept those on `idle` moving at up to 2 cm/s, 24 times a
     // second.
-    if (crosses(interaction_hz_, i)) {
+    const bool interact = crosses(interaction_hz_, i);
+    if (schedule_ == Schedule::PerStage) {
+      // plante_wisp_ref: the same stages in the same order, one pass over all wisps each
+      // (the schedule before issue 10; it reads every wisp's state once per stage).
+      stage_pass(times, "integration", [&](std::size_t w) {
+        k::wisp_pin(sys_, w, head, h);
+        k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head_rot, in.gravity, in.wind, h);
+      });
+      if (body_on) stage_pass(times, "body_collision", [&](std::size_t w) { k::wisp_body_slide(sys_, w, body, drag); });
+      if (interact) {
+        StageTimer t(times, "self_interaction");
+        detect_self_interactions();
+        k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
+      }
+      stage_pass(times, "integration",
+                 [&](std::size_t w) { k::wisp_positions(sys_, w, head_rot * sys_.rest_e1[w], h); });
+      if (body_on) stage_pass(times, "body_collision", [&](std::size_t w) { k::wisp_body_hold(sys_, w, body); });
+      if (body_due)
+        stage_pass(times, "body_collision", [&](std::size_t w) {
+          k::wisp_body_detect(sys_, w, body, head_rot * sys_.rest_e1[w], interaction_.contact_threshold);
+        });
+    } else if (interact) {
       wisp_pass(times, velocities);
       {
         StageTimer t(times, "self_interaction");
@@ -476,6 +509,8 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
     body(0, rest_.strand_count());
 }
 
-std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx) { return std::make_unique<PlanteWispModel>(ctx); }
+std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx, Schedule schedule) {
+  return std::make_unique<PlanteWispModel>(ctx, schedule);
+}
 
 }  // namespace hairbench::plante

@@ -15,13 +15,20 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 namespace hairbench::plante {
 
+// How a step visits the wisps (issue 10). Fused: each wisp goes through all of a step's
+// stages in one pass while it is in cache (plante_wisp). PerStage: one pass over all
+// wisps per stage, the schedule before issue 10, kept as plante_wisp_ref; both run the
+// same kernels in the same order per wisp, so their results are bit-identical.
+enum class Schedule { Fused, PerStage };
+
 class PlanteWispModel final : public HairModel {
  public:
-  explicit PlanteWispModel(const ModelContext& ctx);
+  explicit PlanteWispModel(const ModelContext& ctx, Schedule schedule = Schedule::Fused);
   void reset(const Groom& rest, const ParamSet& params) override;
   // Stages: "integration", "body_collision", "self_interaction", "rebuild".
   void step(const FrameInput& in, StageTimes& out_times) override;
@@ -53,12 +60,19 @@ class PlanteWispModel final : public HairModel {
     std::array<std::atomic<std::int64_t>*, 2> sampled_ns{};
     void lap(int stage);  // time since the last lap to `stage`, on sampled wisps
   };
+  // f(begin, end) over the wisps, split statically over the threads.
+  template <class F>
+  void for_each_wisp(F&& f);
   // f(w, clock) for every wisp, over the threads; adds the pass's time to the stages.
   template <class F>
   void wisp_pass(StageTimes& times, F&& f);
+  // f(w) for every wisp, over the threads, timed as `stage` (the per-stage schedule).
+  template <class F>
+  void stage_pass(StageTimes& times, std::string_view stage, F&& f);
   void detect_self_interactions();
 
   ModelContext ctx_;
+  Schedule schedule_;
   Groom rest_;
   std::vector<kernels::WispParams> params_;  // per groom region
   kernels::InteractionParams interaction_;
@@ -83,6 +97,6 @@ class PlanteWispModel final : public HairModel {
   std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};
 };
 
-std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx);
+std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx, Schedule schedule = Schedule::Fused);
 
 }  // namespace hairbench::plante
