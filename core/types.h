@@ -54,4 +54,16 @@ inline Vec3f collider_center(const Sphere& s, const Affine3f& head) {
   return s.head_attached ? Vec3f(head * s.center) : s.center;
 }
 
+// The colliders as world-space x, y, z, radius quadruples under head transform `head`
+// (the sphere arrays of the block kernels); out holds 4 * colliders.size() floats.
+inline void write_spheres(std::span<const Sphere> colliders, const Affine3f& head, float* out) {
+  for (std::size_t c = 0; c < colliders.size(); ++c) {
+    const Vec3f center = collider_center(colliders[c], head);
+    out[4 * c] = center.x();
+    out[4 * c + 1] = center.y();
+    out[4 * c + 2] = center.z();
+    out[4 * c + 3] = colliders[c].radius;
+  }
+}
+
 }  // namespace hairbench

@@ -5,7 +5,7 @@
 // without wind and colliders, through sleep and wake. The forest kernel reorders the
 // joint rotations and computes sin/cos by polynomial, so it must agree to rounding. No
 // state may depend on the thread count or on the ISA variant of the kernel.
-#include "test_support.h"
+#include "agreement_support.h"
 
 #include "core/parallel.h"
 #include "kernels/cpu/halen_soa.h"
@@ -23,40 +23,9 @@
 namespace hairbench {
 namespace {
 
-Scenario paper_model1(std::size_t keep_every) {
-  Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_PAPER_SCENARIO_DIR) / "han2012_model1.json");
-  sc.groom = every_nth_strand(sc.groom, keep_every);
-  return sc;
-}
-
-std::unique_ptr<HairModel> make(const std::string& name, const Scenario& sc, const std::vector<ParamOverride>& ov,
-                                ThreadPool& pool, bool skip_inert = true) {
-  const ModelInfo* info = find_model(name);
-  if (!info) throw std::runtime_error("no model " + name);
-  return make_model(*info, sc, resolve_params(*info, sc, ov), pool, "", skip_inert);
-}
-
-// Steps two models in lockstep; the first frame whose positions differ in any bit, or
-// -1. `max_diff` gets the largest coordinate difference over all frames.
-int first_difference(const Scenario& sc, const std::string& a, const std::string& b, int frames,
-                     const std::vector<ParamOverride>& ov, double* max_diff = nullptr, bool skip_inert = true) {
-  ThreadPool pool(2);
-  auto ma = make(a, sc, ov, pool, skip_inert);
-  auto mb = make(b, sc, ov, pool, skip_inert);
-  int first = -1;
-  double worst = 0.0;
-  for (int f = 0; f < frames; ++f) {
-    const FrameInput in = frame_input(sc, f);
-    StageTimes t;
-    ma->step(in, t);
-    mb->step(in, t);
-    const auto pa = ma->positions(), pb = mb->positions();
-    if (first < 0 && std::memcmp(pa.data(), pb.data(), pa.size_bytes()) != 0) first = f;
-    for (std::size_t i = 0; i < pa.size(); ++i) worst = std::max(worst, double((pa[i] - pb[i]).cwiseAbs().maxCoeff()));
-  }
-  if (max_diff) *max_diff = worst;
-  return first;
-}
+using test::first_difference;
+using test::paper_model1;
+using test::state_hash_after;
 
 const std::vector<std::string> kExact = {"halen_spring", "halen_cascade"};
 const std::vector<std::string> kFused = {"halen_spring", "halen_cascade", "halen_forest"};
@@ -93,14 +62,7 @@ TEST(HalenFused, BitIdenticalToReferenceOnRaggedPaperGroom) {
 // Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
 // and wake when the head turns, in both implementations.
 TEST(HalenFused, BitIdenticalToReferenceThroughSleepAndWake) {
-  Scenario sc = test::builtin("idle", 16);
-  sc.frames = 200;
-  Oscillator turn;
-  turn.kind = Oscillator::Kind::Rotate;
-  turn.amplitude = 0.5;
-  turn.start = 2.0;
-  turn.end = 10.0;
-  sc.head.oscillators = {turn};
+  const Scenario sc = test::idle_then_turn();
   for (const std::string& m : kExact) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
 }
 
@@ -120,8 +82,8 @@ TEST(HalenFused, BitIdenticalToReferenceWithoutSkipping) {
 TEST(HalenFused, ForestAgreesWithReferenceOnShake) {
   const Scenario sc = test::builtin("shake", 8);
   ThreadPool pool(2);
-  auto fast = make("halen_forest", sc, {}, pool);
-  auto ref = make("halen_forest_ref", sc, {}, pool);
+  auto fast = test::make_named("halen_forest", sc, {}, pool);
+  auto ref = test::make_named("halen_forest_ref", sc, {}, pool);
   const metrics::RestInfo rest(sc.groom);
   double worst = 0.0;
   for (int f = 0; f < sc.frames; ++f) {
@@ -143,8 +105,8 @@ TEST(HalenFused, ForestAgreesWithReferenceInWindAndOnPaperGroom) {
   const std::vector<ParamOverride> own_substeps = {{"*", "substeps", 12}};
   for (const Scenario& sc : {test::builtin("wind_gust", 16), paper_model1(16)}) {
     ThreadPool pool(2);
-    auto fast = make("halen_forest", sc, own_substeps, pool);
-    auto ref = make("halen_forest_ref", sc, own_substeps, pool);
+    auto fast = test::make_named("halen_forest", sc, own_substeps, pool);
+    auto ref = test::make_named("halen_forest_ref", sc, own_substeps, pool);
     const metrics::RestInfo rest(sc.groom);
     double worst = 0.0;
     for (int f = 0; f < 120; ++f) {
@@ -171,16 +133,6 @@ TEST(HalenFused, PolynomialSinCosMatchesLibm) {
   kernels::sincos_poly(3e9f, s, c);
   EXPECT_LE(std::abs(s), 1.0f + 1e-6f);
   EXPECT_LE(std::abs(c), 1.0f + 1e-6f);
-}
-
-std::uint64_t state_hash_after(const Scenario& sc, const std::string& model, int threads, int frames) {
-  ThreadPool pool(threads);
-  auto m = make(model, sc, {}, pool);
-  for (int f = 0; f < frames; ++f) {
-    StageTimes t;
-    m->step(frame_input(sc, f), t);
-  }
-  return metrics::state_hash(m->positions());
 }
 
 TEST(HalenFused, StateHashIndependentOfThreadCount) {
@@ -218,7 +170,7 @@ TEST(HalenFused, StagesAreReported) {
   const Scenario sc = test::builtin("shake", 16);
   ThreadPool pool(2);
   for (const std::string& name : kExact) {
-    auto m = make(name, sc, {}, pool);
+    auto m = test::make_named(name, sc, {}, pool);
     FrameInput in = frame_input(sc, 0);
     in.colliders = {};
     StageTimes t;
@@ -229,7 +181,7 @@ TEST(HalenFused, StagesAreReported) {
                            {"references", false}, {"integrate", false}, {"length", false}, {"collision", true}}))
         << name;
   }
-  auto forest = make("halen_forest", sc, {}, pool);
+  auto forest = test::make_named("halen_forest", sc, {}, pool);
   StageTimes t;
   forest->step(frame_input(sc, 0), t);
   std::map<std::string, bool> skipped;

@@ -5,7 +5,7 @@
 // ragged vertex counts, several regions), with and without wind, colliders and the
 // stages a region switches off; and the state must not depend on the thread count or
 // on the ISA variant of the kernel.
-#include "test_support.h"
+#include "agreement_support.h"
 
 #include "core/parallel.h"
 #include "kernels/cpu/han_soa.h"
@@ -24,40 +24,9 @@
 namespace hairbench {
 namespace {
 
-Scenario paper_model1(std::size_t keep_every) {
-  Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_PAPER_SCENARIO_DIR) / "han2012_model1.json");
-  sc.groom = every_nth_strand(sc.groom, keep_every);
-  return sc;
-}
-
-std::unique_ptr<HairModel> make(const std::string& name, const Scenario& sc, const std::vector<ParamOverride>& ov,
-                                ThreadPool& pool, bool skip_inert = true) {
-  const ModelInfo* info = find_model(name);
-  if (!info) throw std::runtime_error("no model " + name);
-  return make_model(*info, sc, resolve_params(*info, sc, ov), pool, "", skip_inert);
-}
-
-// Steps two models in lockstep; the first frame whose positions differ in any bit, or
-// -1. `max_diff` gets the largest coordinate difference over all frames.
-int first_difference(const Scenario& sc, const std::string& a, const std::string& b, int frames,
-                     const std::vector<ParamOverride>& ov, double* max_diff = nullptr, bool skip_inert = true) {
-  ThreadPool pool(2);
-  auto ma = make(a, sc, ov, pool, skip_inert);
-  auto mb = make(b, sc, ov, pool, skip_inert);
-  int first = -1;
-  double worst = 0.0;
-  for (int f = 0; f < frames; ++f) {
-    const FrameInput in = frame_input(sc, f);
-    StageTimes t;
-    ma->step(in, t);
-    mb->step(in, t);
-    const auto pa = ma->positions(), pb = mb->positions();
-    if (first < 0 && std::memcmp(pa.data(), pb.data(), pa.size_bytes()) != 0) first = f;
-    for (std::size_t i = 0; i < pa.size(); ++i) worst = std::max(worst, double((pa[i] - pb[i]).cwiseAbs().maxCoeff()));
-  }
-  if (max_diff) *max_diff = worst;
-  return first;
-}
+using test::first_difference;
+using test::paper_model1;
+using test::state_hash_after;
 
 const std::vector<std::string> kMethods = {"han_m1", "han_m2", "han_m3"};
 
@@ -110,14 +79,7 @@ TEST(HanFused, BitIdenticalWithStagesOff) {
 // Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
 // and wake when the head turns, in both implementations.
 TEST(HanFused, BitIdenticalToReferenceThroughSleepAndWake) {
-  Scenario sc = test::builtin("idle", 16);
-  sc.frames = 200;
-  Oscillator turn;
-  turn.kind = Oscillator::Kind::Rotate;
-  turn.amplitude = 0.5;
-  turn.start = 2.0;
-  turn.end = 10.0;
-  sc.head.oscillators = {turn};
+  const Scenario sc = test::idle_then_turn();
   for (const std::string& m : kMethods) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
 }
 
@@ -148,8 +110,8 @@ TEST(HanFused, PerRegionMethod) {
   mixed.set_region(1, "method", 3, {"test", ""});
   han_fused::HanFusedModel fast(han::Method::Serial, ModelContext{&pool});
   fast.reset(sc.groom, mixed);
-  auto m1 = make("han_m1_ref", sc, {}, pool);
-  auto m3 = make("han_m3_ref", sc, {}, pool);
+  auto m1 = test::make_named("han_m1_ref", sc, {}, pool);
+  auto m3 = test::make_named("han_m3_ref", sc, {}, pool);
   for (int f = 0; f < 30; ++f) {
     const FrameInput in = frame_input(sc, f);
     StageTimes t;
@@ -167,16 +129,6 @@ TEST(HanFused, PerRegionMethod) {
   }
   EXPECT_GT(checked[0], 0u);
   EXPECT_GT(checked[1], 0u);
-}
-
-std::uint64_t state_hash_after(const Scenario& sc, const std::string& model, int threads, int frames) {
-  ThreadPool pool(threads);
-  auto m = make(model, sc, {}, pool);
-  for (int f = 0; f < frames; ++f) {
-    StageTimes t;
-    m->step(frame_input(sc, f), t);
-  }
-  return metrics::state_hash(m->positions());
 }
 
 TEST(HanFused, StateHashIndependentOfThreadCount) {
@@ -211,7 +163,7 @@ TEST(HanFused, IsaVariantsGiveTheSameBits) {
 TEST(HanFused, SkippedStagesAreReported) {
   Scenario sc = test::builtin("shake", 16);
   ThreadPool pool(2);
-  auto m = make("han_m3", sc, {{"*", "global_stiffness", 0.0}}, pool);
+  auto m = test::make_named("han_m3", sc, {{"*", "global_stiffness", 0.0}}, pool);
   FrameInput in = frame_input(sc, 0);
   in.colliders = {};
   StageTimes t;

@@ -2,9 +2,9 @@
 // halen_kernels.cpp, kLanes strands at a time). Compiled once per ISA variant, like
 // halen_soa_kernel.cpp.
 #include "kernels/cpu/halen_soa.h"
+#include "kernels/cpu/soa_common.h"
 #include "kernels/cpu/vec_math.h"
 
-#include <chrono>
 #include <cmath>
 
 #ifndef HALEN_SOA_VARIANT
@@ -18,27 +18,6 @@ namespace {
 constexpr int W = kLanes;
 
 #define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
-
-class Clock {
- public:
-  explicit Clock(std::int64_t* ns) : ns_(ns) {
-    if (ns_) last_ = now();
-  }
-  void lap(ForestStage s) {
-    if (!ns_) return;
-    const std::int64_t t = now();
-    ns_[s] += t - last_;
-    last_ = t;
-  }
-
- private:
-  static std::int64_t now() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  }
-  std::int64_t* ns_;
-  std::int64_t last_ = 0;
-};
 
 struct Rows {
   int n;
@@ -236,7 +215,7 @@ void forest_frame(const Block& b, const ForestParams& p, const ForestFrame& f, f
   Rows r{n,          b.data,           b.state,          scratch,          scratch + 9 * rows,
          scratch + 10 * rows, scratch + 11 * rows, scratch + 12 * rows, scratch + 13 * rows, scratch + 14 * rows,
          b.rows};
-  Clock clock(stage_ns);
+  soa::StageClock clock(stage_ns);
   for (int k = 0; k < f.substep_count; ++k) {
     if (f.parent_x)
       pose<true>(r, f.substeps[k]);

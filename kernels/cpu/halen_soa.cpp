@@ -1,5 +1,6 @@
 // Run-time choice of the halen_soa kernel variant (see kernels/CMakeLists.txt).
 #include "kernels/cpu/halen_soa.h"
+#include "kernels/cpu/soa_common.h"
 
 namespace hairbench::kernels::halen_soa {
 
@@ -17,9 +18,7 @@ ForestFrameFn forest_frame_fn();
 namespace {
 bool has_v4() {
 #ifdef HAIRBENCH_HALEN_SOA_V4
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-         __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+  return soa::cpu_has_x86_64_v4();
 #else
   return false;
 #endif

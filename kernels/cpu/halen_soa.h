@@ -16,6 +16,8 @@
 // and for any thread count.
 #pragma once
 
+#include "kernels/cpu/soa_common.h"
+
 #include <cstddef>
 #include <cstdint>
 
@@ -81,13 +83,7 @@ struct Substep {
   int sphere_count;
 };
 
-struct Frame {
-  const Substep* substeps;
-  int substep_count;
-  float gravity[3];
-  float wind[3];  // wind acceleration; used only when windy
-  bool windy;
-};
+using Frame = soa::BlockFrame<Substep>;
 
 enum Stage : int { kReferences, kIntegrate, kLength, kCollision, kStageCount };
 
@@ -125,12 +121,8 @@ struct ForestSubstep {
   const float* spheres;  // world-space x, y, z, r
   int sphere_count;
 };
-struct ForestFrame {
-  const ForestSubstep* substeps;  // substep_count, then the frame's final head pose
-  int substep_count;
-  float gravity[3];
-  float wind[3];
-  bool windy;
+// substeps: substep_count of them, then the frame's final head pose.
+struct ForestFrame : soa::BlockFrame<ForestSubstep> {
   bool parent_x;  // ForestAxes::ParentX (else ParentZ)
   float dt;
 };

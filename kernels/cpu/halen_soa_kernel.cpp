@@ -3,8 +3,8 @@
 // loops over lanes are written plainly so the compiler turns each into vector
 // instructions of that variant.
 #include "kernels/cpu/halen_soa.h"
+#include "kernels/cpu/soa_common.h"
 
-#include <chrono>
 #include <cmath>
 
 #ifndef HALEN_SOA_VARIANT
@@ -19,39 +19,6 @@ constexpr int W = kLanes;
 
 #define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
 
-// The head transform in locals (no aliasing with the rows for the vectoriser), applied
-// as Eigen evaluates Affine3f · Vector3f: t + ((m00 x + m01 y) + m02 z).
-struct Pose {
-  float m0, m1, m2, m3, m4, m5, m6, m7, m8, t0, t1, t2;
-  explicit Pose(const Substep& s)
-      : m0(s.m[0]), m1(s.m[1]), m2(s.m[2]), m3(s.m[3]), m4(s.m[4]), m5(s.m[5]), m6(s.m[6]), m7(s.m[7]),
-        m8(s.m[8]), t0(s.t[0]), t1(s.t[1]), t2(s.t[2]) {}
-  float x(float a, float b, float c) const { return t0 + ((m0 * a + m1 * b) + m2 * c); }
-  float y(float a, float b, float c) const { return t1 + ((m3 * a + m4 * b) + m5 * c); }
-  float z(float a, float b, float c) const { return t2 + ((m6 * a + m7 * b) + m8 * c); }
-};
-
-class Clock {
- public:
-  explicit Clock(std::int64_t* ns) : ns_(ns) {
-    if (ns_) last_ = now();
-  }
-  void lap(Stage s) {
-    if (!ns_) return;
-    const std::int64_t t = now();
-    ns_[s] += t - last_;
-    last_ = t;
-  }
-
- private:
-  static std::int64_t now() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  }
-  std::int64_t* ns_;
-  std::int64_t last_ = 0;
-};
-
 // A block's rows: [component][vertex][lane].
 struct Rows {
   int n;
@@ -64,7 +31,7 @@ struct Rows {
 };
 
 // Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest.
-void follow_head(const Rows& r, const Pose& h) {
+void follow_head(const Rows& r, const soa::AffinePose& h) {
   for (int i = 0; i < r.n; ++i) {
     if (r.kind[i] == kRowFree) continue;
     const int o = i * W;
@@ -223,7 +190,7 @@ void collide(const Rows& r, const Substep& s) {
 }
 
 // §4.4: reference nodes rigid with the head, lifted against gravity (head_references).
-void spring_references(const Rows& r, const Pose& h, const Frame& f) {
+void spring_references(const Rows& r, const soa::AffinePose& h, const Frame& f) {
   const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
   for (int i = 0; i < r.n; ++i) {
     const int o = i * W;
@@ -348,10 +315,10 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
          scratch + 5 * rows,
          b.data,
          b.rows};
-  Clock clock(stage_ns);
+  soa::StageClock clock(stage_ns);
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
-    const Pose h(s);
+    const soa::AffinePose h(s.m, s.t);
     if constexpr (kModel == Model::Spring) {
       spring_references(r, h, f);
       clock.lap(kReferences);

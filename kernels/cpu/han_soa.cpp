@@ -1,5 +1,6 @@
 // Run-time choice of the han_soa kernel variant (see kernels/CMakeLists.txt).
 #include "kernels/cpu/han_soa.h"
+#include "kernels/cpu/soa_common.h"
 
 namespace hairbench::kernels::han_soa {
 
@@ -15,9 +16,7 @@ FrameFn frame_fn();
 namespace {
 bool has_v4() {
 #ifdef HAIRBENCH_HAN_SOA_V4
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-         __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+  return soa::cpu_has_x86_64_v4();
 #else
   return false;
 #endif

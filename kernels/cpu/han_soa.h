@@ -13,6 +13,8 @@
 // (han_m*_ref) on any ISA variant and for any thread count.
 #pragma once
 
+#include "kernels/cpu/soa_common.h"
+
 #include <cstddef>
 #include <cstdint>
 
@@ -82,13 +84,7 @@ struct Substep {
   int sphere_count;
 };
 
-struct Frame {
-  const Substep* substeps;
-  int substep_count;
-  float gravity[3];
-  float wind[3];  // wind acceleration; used only when windy
-  bool windy;
-};
+using Frame = soa::BlockFrame<Substep>;
 
 enum Stage : int { kIntegrate, kGlobal, kLocal, kLength, kCollision, kStageCount };
 

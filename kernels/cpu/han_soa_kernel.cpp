@@ -3,8 +3,8 @@
 // loops over lanes are written plainly so the compiler turns each into vector
 // instructions of that variant.
 #include "kernels/cpu/han_soa.h"
+#include "kernels/cpu/soa_common.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 
@@ -121,49 +121,16 @@ inline void local_edge(float* __restrict ax, float* __restrict ay, float* __rest
   }
 }
 
-// The head transform in locals (no aliasing with the rows for the vectoriser), applied
-// as Eigen evaluates Affine3f · Vector3f: t + ((m00 x + m01 y) + m02 z).
-struct Pose {
-  float m0, m1, m2, m3, m4, m5, m6, m7, m8, t0, t1, t2;
-  explicit Pose(const Substep& s)
-      : m0(s.m[0]), m1(s.m[1]), m2(s.m[2]), m3(s.m[3]), m4(s.m[4]), m5(s.m[5]), m6(s.m[6]), m7(s.m[7]),
-        m8(s.m[8]), t0(s.t[0]), t1(s.t[1]), t2(s.t[2]) {}
-  float x(float a, float b, float c) const { return t0 + ((m0 * a + m1 * b) + m2 * c); }
-  float y(float a, float b, float c) const { return t1 + ((m3 * a + m4 * b) + m5 * c); }
-  float z(float a, float b, float c) const { return t2 + ((m6 * a + m7 * b) + m8 * c); }
-};
-
 struct Rows {
   float *px, *py, *pz, *qx, *qy, *qz;
   const float *iw, *rx, *ry, *rz, *rl;
-};
-
-class Clock {
- public:
-  explicit Clock(std::int64_t* ns) : ns_(ns) {
-    if (ns_) last_ = now();
-  }
-  void lap(Stage s) {
-    if (!ns_) return;
-    const std::int64_t t = now();
-    ns_[s] += t - last_;
-    last_ = t;
-  }
-
- private:
-  static std::int64_t now() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  }
-  std::int64_t* ns_;
-  std::int64_t last_ = 0;
 };
 
 // Pinned vertices follow the head (follow_head), free ones are Verlet-integrated
 // (verlet_integrate); row by row, so the wind term sees vertex i-1 already moved, as in
 // the per-strand kernel.
 template <bool kWindy, RowKind kKind>
-inline void integrate_row(const Rows& r, int i, const Pose& h, const Substep& s, const Frame& f, float keep) {
+inline void integrate_row(const Rows& r, int i, const soa::AffinePose& h, const Substep& s, const Frame& f, float keep) {
   const int o = i * W;
   float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
   const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
@@ -241,7 +208,7 @@ inline void integrate_row(const Rows& r, int i, const Pose& h, const Substep& s,
 // the per-strand kernel.
 template <bool kWindy>
 void integrate(const Rows& r, const RowKind* kinds, int n, const Substep& s, const Frame& f, float keep) {
-  const Pose h(s);
+  const soa::AffinePose h(s.m, s.t);
   for (int i = 0; i < n; ++i) {
     switch (kinds[i]) {
       case kRowFree:
@@ -259,7 +226,7 @@ void integrate(const Rows& r, const RowKind* kinds, int n, const Substep& s, con
 
 // Eq. 2 (global_shape): free vertices below reach move towards T_H · P_i^0.
 void global_shape(const Rows& r, const RowKind* kinds, int n, const Substep& s, const BlockParams& p) {
-  const Pose h(s);
+  const soa::AffinePose h(s.m, s.t);
   for (int i = 0; i < n && static_cast<float>(i) < p.global_reach; ++i) {
     if (kinds[i] == kRowPinned) continue;
     const int o = i * W;
@@ -574,7 +541,7 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
   }
   const bool local_on = p.local_iterations > 0;
   const int iterations = p.local_iterations > p.length_iterations ? p.local_iterations : p.length_iterations;
-  Clock clock(stage_ns);
+  soa::StageClock clock(stage_ns);
   if (local_on) {
     for (int j = 0; j < count; ++j) mass_weights(c[j].r, n, c[j].ka, c[j].kb);
     clock.lap(kLocal);

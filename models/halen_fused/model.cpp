@@ -332,24 +332,11 @@ void HalenFusedModel::forest_substeps(const FrameInput& in, float dt) {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) s.inertia[4 * r + c] = inertia(r, c);
     float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
-    for (std::size_t c = 0; c < nc; ++c) {
-      const Vec3f center = collider_center(in.colliders[c], head);
-      sp[4 * c] = center.x();
-      sp[4 * c + 1] = center.y();
-      sp[4 * c + 2] = center.z();
-      sp[4 * c + 3] = in.colliders[c].radius;
-    }
+    write_spheres(in.colliders.first(nc), head, sp);
     s.spheres = sp;
     s.sphere_count = static_cast<int>(nc);
   }
-  forest_frame_.substeps = forest_substep_.data();
-  forest_frame_.substep_count = substeps_;
-  const Vec3f wind = in.wind.acceleration();
-  for (int c = 0; c < 3; ++c) {
-    forest_frame_.gravity[c] = in.gravity[c];
-    forest_frame_.wind[c] = wind[c];
-  }
-  forest_frame_.windy = in.wind.active();
+  set_block_frame(forest_frame_, forest_substep_, substeps_, in, in.wind.active());
   forest_frame_.dt = dt;
 }
 
@@ -383,13 +370,7 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
     }
     s.dt2 = dt * dt;
     float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
-    for (std::size_t c = 0; c < nc; ++c) {
-      const Vec3f center = collider_center(in.colliders[c], head);
-      sp[4 * c] = center.x();
-      sp[4 * c + 1] = center.y();
-      sp[4 * c + 2] = center.z();
-      sp[4 * c + 3] = in.colliders[c].radius;
-    }
+    write_spheres(in.colliders.first(nc), head, sp);
     s.spheres = sp;
     s.sphere_count = static_cast<int>(nc);
     if (model_ == Model::Spring) {
@@ -399,47 +380,21 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
             k::tilt_factor(up, head_up, region_[r].tilt_min);
     }
   }
-  frame_.substeps = substep_.data();
-  frame_.substep_count = substeps_;
-  const Vec3f wind = in.wind.acceleration();
-  for (int c = 0; c < 3; ++c) {
-    frame_.gravity[c] = in.gravity[c];
-    frame_.wind[c] = wind[c];
-  }
-  frame_.windy = plan.wind;  // no wind, no wind term
+  set_block_frame(frame_, substep_, substeps_, in, plan.wind);  // no wind, no wind term
 
-  for (ThreadState& ts : threads_) {
-    ts.stage_ns.fill(0);
-    ts.sampled_ns = 0;
-  }
-  HalenFusedModel* self = this;  // one pointer: the std::function stores it without allocating
-  if (ctx_.pool)
-    ctx_.pool->parallel_for(threads_.size(), [self](std::size_t b, std::size_t e) {
-      for (std::size_t t = b; t < e; ++t) self->run_thread(static_cast<int>(t));
-    });
-  else
-    run_thread(0);
+  clear_stage_clocks(threads_);
+  for_each_block_thread(ctx_.pool, threads_.size(), [this](int t) { run_thread(t); });
 
   // Per-stage times without a clock read per stage per block: the sampled blocks time
   // their stages; each stage's share of their time, times the step's wall time, is the
   // stage's time.
   const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::array<std::int64_t, soa::kStageCount> ns{};
-  std::int64_t sampled = 0;
-  for (const ThreadState& ts : threads_) {
-    for (int s = 0; s < soa::kStageCount; ++s) ns[s] += ts.stage_ns[s];
-    sampled += ts.sampled_ns;
-  }
-  auto report = [&](std::string_view name, soa::Stage s, bool ran) {
-    if (!ran) {
-      times.skip(name);
-      return;
-    }
-    times.add(name, sampled > 0 ? wall_ms * static_cast<double>(ns[s]) / static_cast<double>(sampled) : 0.0);
-  };
+  const SampledStageTimes stages(threads_, wall_ms);
+  auto report = [&](std::string_view name, int stage, bool ran) { stages.report(times, name, stage, ran); };
+
   if (forest) {
-    report("pose", static_cast<soa::Stage>(soa::kPose), true);
-    report("integrate", static_cast<soa::Stage>(soa::kForestIntegrate), true);
+    report("pose", soa::kPose, true);
+    report("integrate", soa::kForestIntegrate, true);
   } else {
     report("references", soa::kReferences, true);
     report("integrate", soa::kIntegrate, true);
@@ -448,12 +403,7 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
   }
   if (calm_) {
     StageTimer t(times, "sleep");
-    if (ctx_.pool)
-      ctx_.pool->parallel_for(threads_.size(), [self, dt](std::size_t b, std::size_t e) {
-        for (std::size_t t = b; t < e; ++t) self->observe_sleep(static_cast<int>(t), dt);
-      });
-    else
-      observe_sleep(0, dt);
+    for_each_block_thread(ctx_.pool, threads_.size(), [this, dt](int t) { observe_sleep(t, dt); });
     sleep_.end_observe();
   }
 }

@@ -10,6 +10,7 @@
 #include "core/hair_model.h"
 #include "core/sleep.h"
 #include "kernels/cpu/halen_soa.h"
+#include "models/block_threads.h"
 
 #include <array>
 #include <memory>
@@ -51,11 +52,7 @@ class HalenFusedModel final : public HairModel {
     std::array<std::uint32_t, W> strand{};     // per lane: the strand, or kNoStrand for a repeat
     std::array<std::uint32_t, W> source{};     // per lane: the strand it computes (repeats included)
   };
-  struct ThreadState {
-    std::size_t first = 0, last = 0;  // blocks
-    std::array<std::int64_t, kernels::halen_soa::kStageCount> stage_ns{};
-    std::int64_t sampled_ns = 0;
-  };
+  using ThreadState = BlockThread<kernels::halen_soa::kStageCount>;  // first/last: blocks
   static constexpr std::uint32_t kNoStrand = 0xffffffffu;
   std::size_t block_floats(int n) const;
   std::size_t state_floats(int n) const;

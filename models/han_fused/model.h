@@ -7,6 +7,7 @@
 #include "core/hair_model.h"
 #include "core/sleep.h"
 #include "kernels/cpu/han_soa.h"
+#include "models/block_threads.h"
 #include "models/han/model.h"
 
 #include <array>
@@ -56,11 +57,7 @@ class HanFusedModel final : public HairModel {
     int count;
     bool sampled;  // times its stages (see step())
   };
-  struct alignas(64) ThreadState {
-    std::array<std::int64_t, kernels::han_soa::kStageCount> stage_ns{};
-    std::int64_t sampled_ns = 0;
-    std::size_t first = 0, last = 0;  // jobs [first, last)
-  };
+  using ThreadState = BlockThread<kernels::han_soa::kStageCount>;
   void run_thread(int t);
   void prefetch(const Job& job) const;
   void observe_sleep(int t, float dt);

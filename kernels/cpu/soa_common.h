@@ -1,0 +1,70 @@
+// Pieces shared by the structure-of-arrays block kernels (han_soa, halen_soa): the
+// per-stage clock of sampled blocks, the head transform in Eigen's evaluation order, and
+// the run-time check for the x86-64-v4 (AVX-512) variant.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+
+namespace hairbench::kernels::soa {
+
+// Adds the nanoseconds since the last lap to ns[stage]; does nothing when ns is null (a
+// block that is not sampled), so unsampled blocks read no clock.
+class StageClock {
+ public:
+  explicit StageClock(std::int64_t* ns) : ns_(ns) {
+    if (ns_) last_ = now();
+  }
+  void lap(int stage) {
+    if (!ns_) return;
+    const std::int64_t t = now();
+    ns_[stage] += t - last_;
+    last_ = t;
+  }
+
+ private:
+  static std::int64_t now() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  std::int64_t* ns_;
+  std::int64_t last_ = 0;
+};
+
+// The head transform (row-major linear part m, translation t) in locals, so the
+// vectoriser sees no aliasing with the rows, applied as Eigen evaluates
+// Affine3f · Vector3f: t + ((m00 x + m01 y) + m02 z). Same bits as the per-strand kernels.
+struct AffinePose {
+  float m0, m1, m2, m3, m4, m5, m6, m7, m8, t0, t1, t2;
+  AffinePose(const float* m, const float* t)
+      : m0(m[0]), m1(m[1]), m2(m[2]), m3(m[3]), m4(m[4]), m5(m[5]), m6(m[6]), m7(m[7]), m8(m[8]), t0(t[0]),
+        t1(t[1]), t2(t[2]) {}
+  float x(float a, float b, float c) const { return t0 + ((m0 * a + m1 * b) + m2 * c); }
+  float y(float a, float b, float c) const { return t1 + ((m3 * a + m4 * b) + m5 * c); }
+  float z(float a, float b, float c) const { return t2 + ((m6 * a + m7 * b) + m8 * c); }
+};
+
+// One frame of a block kernel: its substeps (head pose and colliders, computed once per
+// step for every block) and the forces. The wind is the wind acceleration, used only
+// when windy.
+template <class SubstepT>
+struct BlockFrame {
+  const SubstepT* substeps;
+  int substep_count;
+  float gravity[3];
+  float wind[3];
+  bool windy;
+};
+
+// Whether this CPU runs the x86-64-v4 variants (AVX-512 F, BW, DQ, VL).
+inline bool cpu_has_x86_64_v4() {
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+         __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+#else
+  return false;
+#endif
+}
+
+}  // namespace hairbench::kernels::soa

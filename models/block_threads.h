@@ -1,0 +1,87 @@
+// Threads of the fused block models (han_fused, halen_fused): each thread owns a fixed
+// range of blocks (static partition, so no result depends on the thread count), and the
+// blocks it samples time their stages (soa::StageClock). A stage's time is its share of
+// the sampled time, times the step's wall time: no clock read per stage per block.
+#pragma once
+
+#include "core/hair_model.h"
+#include "core/parallel.h"
+#include "kernels/cpu/soa_common.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace hairbench {
+
+template <std::size_t kStages>
+struct alignas(64) BlockThread {
+  std::array<std::int64_t, kStages> stage_ns{};
+  std::int64_t sampled_ns = 0;
+  std::size_t first = 0, last = 0;  // the thread's blocks (or jobs) [first, last)
+};
+
+// run(t) for every thread t: on the pool when there is one, else thread 0 inline.
+template <class F>
+void for_each_block_thread(ThreadPool* pool, std::size_t threads, const F& run) {
+  if (pool)
+    pool->parallel_for(threads, [&run](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) run(static_cast<int>(t));
+    });
+  else
+    run(0);
+}
+
+template <std::size_t kStages>
+void clear_stage_clocks(std::vector<BlockThread<kStages>>& threads) {
+  for (BlockThread<kStages>& t : threads) {
+    t.stage_ns.fill(0);
+    t.sampled_ns = 0;
+  }
+}
+
+// The step's stage times from its threads' sampled clocks and its wall time.
+template <std::size_t kStages>
+class SampledStageTimes {
+ public:
+  SampledStageTimes(const std::vector<BlockThread<kStages>>& threads, double wall_ms) : wall_ms_(wall_ms) {
+    for (const BlockThread<kStages>& t : threads) {
+      for (std::size_t s = 0; s < kStages; ++s) ns_[s] += t.stage_ns[s];
+      sampled_ += t.sampled_ns;
+    }
+  }
+  // Adds stage `stage` to `times` as `name`, or marks it skipped when it did not run.
+  void report(StageTimes& times, std::string_view name, int stage, bool ran) const {
+    if (!ran) {
+      times.skip(name);
+      return;
+    }
+    const double share = sampled_ > 0 ? static_cast<double>(ns_[static_cast<std::size_t>(stage)]) /
+                                            static_cast<double>(sampled_)
+                                      : 0.0;
+    times.add(name, wall_ms_ * share);
+  }
+
+ private:
+  std::array<std::int64_t, kStages> ns_{};
+  std::int64_t sampled_ = 0;
+  double wall_ms_;
+};
+
+// The frame's substeps and forces for a block kernel; the wind term runs only when windy.
+template <class SubstepT>
+void set_block_frame(kernels::soa::BlockFrame<SubstepT>& f, const std::vector<SubstepT>& substeps, int substep_count,
+                     const FrameInput& in, bool windy) {
+  f.substeps = substeps.data();
+  f.substep_count = substep_count;
+  const Vec3f wind = in.wind.acceleration();
+  for (int c = 0; c < 3; ++c) {
+    f.gravity[c] = in.gravity[c];
+    f.wind[c] = wind[c];
+  }
+  f.windy = windy;
+}
+
+}  // namespace hairbench
