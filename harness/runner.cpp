@@ -8,6 +8,7 @@
 #include "scenarios/phases.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <limits>
 #include <cmath>
@@ -312,15 +313,27 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
 
     // Stability first, so that a reference failing this frame is not used as one.
     const bool driven = in.head.matrix() != in.head_prev.matrix() || in.wind.active();
-    for (Lane& l : lanes) {
-      if (!l.running) continue;
-      std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
-      if (why.empty() && l.energy) {
-        const auto p = l.model->positions();
-        why = l.energy->add(metrics::mechanical_energy(p, l.prev, sc.dt, sc.gravity), driven);
-        l.prev.assign(p.begin(), p.end());
+    // The metrics cost as much as a fast model's step, so they run on the pool: one task
+    // per lane (and below, per lane and metric), each value computed whole by one thread,
+    // so no number depends on the thread count.
+    std::vector<std::string> blowup(lanes.size());
+    pool.parallel_for(lanes.size(), [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        Lane& l = lanes[i];
+        if (!l.running) continue;
+        std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
+        if (why.empty() && l.energy) {
+          const auto p = l.model->positions();
+          why = l.energy->add(metrics::mechanical_energy(p, l.prev, sc.dt, sc.gravity), driven);
+          l.prev.assign(p.begin(), p.end());
+        }
+        blowup[i] = std::move(why);
       }
-      if (why.empty()) continue;
+    });
+    for (std::size_t i = 0; i < lanes.size(); ++i) {
+      Lane& l = lanes[i];
+      const std::string& why = blowup[i];
+      if (!l.running || why.empty()) continue;
       RunRecord& r = l.record;
       r.failure = RunRecord::Failure{f, in.t, why};
       l.running = false;
@@ -332,19 +345,43 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
         v->push_back(nan);
     }
     const bool ref_ok = lanes[0].running;
-    for (Lane& l : lanes) {
-      if (!l.running) continue;
-      const auto p = l.model->positions();
-      RunRecord& r = l.record;
+    enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFrameMetrics };
+    std::vector<std::array<double, kFrameMetrics + 1>> values(lanes.size());  // length: rms, max
+    pool.parallel_for(lanes.size() * kFrameMetrics, [&](std::size_t b, std::size_t e) {
+      for (std::size_t task = b; task < e; ++task) {
+        const std::size_t i = task / kFrameMetrics;
+        if (!lanes[i].running) continue;
+        const auto p = lanes[i].model->positions();
+        auto& v = values[i];
+        switch (static_cast<FrameMetric>(task % kFrameMetrics)) {
+          case kDeviation:
+            v[kDeviation] = ref_ok ? metrics::deviation(p, lanes[0].model->positions(), rest.mean_strand_length)
+                                   : std::numeric_limits<double>::quiet_NaN();
+            break;
+          case kJaggedness: v[kJaggedness] = metrics::jaggedness(rest, p); break;
+          case kLength: {
+            const metrics::LengthError le = metrics::length_error(rest, p);
+            v[kLength] = le.rms;
+            v[kFrameMetrics] = le.max;
+            break;
+          }
+          case kRestShape: v[kRestShape] = metrics::rest_shape_error(rest, p, in.head); break;
+          case kPenetration: v[kPenetration] = metrics::penetration(p, spheres); break;
+          case kFrameMetrics: break;
+        }
+      }
+    });
+    for (std::size_t i = 0; i < lanes.size(); ++i) {
+      if (!lanes[i].running) continue;
+      RunRecord& r = lanes[i].record;
+      const auto& v = values[i];
       r.t.push_back(in.t);
-      r.deviation.push_back(ref_ok ? metrics::deviation(p, lanes[0].model->positions(), rest.mean_strand_length)
-                                   : std::numeric_limits<double>::quiet_NaN());
-      r.jaggedness.push_back(metrics::jaggedness(rest, p));
-      const metrics::LengthError le = metrics::length_error(rest, p);
-      r.length_rms.push_back(le.rms);
-      r.length_max.push_back(le.max);
-      r.rest_shape_error.push_back(metrics::rest_shape_error(rest, p, in.head));
-      r.penetration.push_back(metrics::penetration(p, spheres));
+      r.deviation.push_back(v[kDeviation]);
+      r.jaggedness.push_back(v[kJaggedness]);
+      r.length_rms.push_back(v[kLength]);
+      r.length_max.push_back(v[kFrameMetrics]);
+      r.rest_shape_error.push_back(v[kRestShape]);
+      r.penetration.push_back(v[kPenetration]);
     }
 
     // Snapshots: a new most violent frame replaces the previous one in every lane (a lane
