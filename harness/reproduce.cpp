@@ -3,10 +3,9 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/args.h"
+#include "harness/paper_setups.h"
 #include "harness/runner.h"
 #include "harness/stress.h"
-#include "models/plante_wisp/model.h"
-#include "models/plante_wisp/settings.h"
 #include "models/registry.h"
 #include "reports/metrics.h"
 #include "reports/report.h"
@@ -359,29 +358,16 @@ json reproduce_han(const Ctx& c) {
 // Figure 6.1.1's configuration, as harness/bench/halen_fig611_bench.cpp: the shake head
 // motion repeated every 2 s, one thread, the model's defaults; median µs per frame.
 double time_fig611(const std::string& model_name, int strands, int nodes, int frames) {
-  Scenario sc = load_scenario(find_scenario("shake"));
-  GroomSpec spec;
-  spec.strands = strands;
-  spec.vertices_per_strand = nodes;
-  sc.groom = generate_groom(spec, sc.head_radius, "fig611").groom;
+  const Scenario sc = fig611_scenario(strands, nodes);
   const ModelInfo* info = find_model(model_name);
   ThreadPool pool(1);
   auto model = info->make(ModelContext{&pool});
   model->reset(sc.groom, resolve_params(*info, sc, {}));
   StageTimes times;
-  constexpr double kPeriod = 2.0;
   constexpr int kWarmup = 10;
   std::vector<double> us;
   for (int frame = 0; frame < frames + kWarmup; ++frame) {
-    const double t0 = std::fmod(frame * sc.dt, kPeriod);
-    FrameInput in;
-    in.frame = frame;
-    in.dt = sc.dt;
-    in.t = t0 + sc.dt;
-    in.head_prev = sc.head.at(t0);
-    in.head = sc.head.at(in.t);
-    in.gravity = sc.gravity;
-    in.colliders = sc.colliders;
+    const FrameInput in = fig611_frame_input(sc, frame);
     times.clear();
     const auto start = std::chrono::steady_clock::now();
     model->step(in, times);
@@ -549,53 +535,19 @@ json reproduce_halen(const Ctx& c) {
 
 // --- Plante, Cani & Poulin 2001 --------------------------------------------------------------
 
-// harness/bench/plante_styles_bench.cpp's styles: wisps, nodes per wisp, length.
-struct PlanteStyle {
-  const char* name;
-  int wisps, vertices;
-  double length;
-};
-constexpr PlanteStyle kPlanteStyles[] = {{"short", 199, 5, 0.08}, {"medium", 73, 11, 0.25}, {"long", 56, 9, 0.45}};
-
 struct PlanteResult {
   double wisps = 0, segments = 0, ms_per_sim_s = 0, interaction_share = 0, self_of_interactions = 0;
 };
 
 PlanteResult run_plante(const PlanteStyle& style, int frames) {
-  constexpr double kFrameDt = 1.0 / 24.0;
-  GroomSpec spec;
-  spec.strands = style.wisps * 6;
-  spec.vertices_per_strand = style.vertices;
-  spec.length = style.length;
-  const Groom groom = generate_groom(spec, 0.1f, "reproduce").groom;
-  Scenario shake = load_scenario(find_scenario("shake"));
-  shake.dt = kFrameDt;  // the head script of `shake`, sampled at the paper's 24 frames/s
-  ParamSet params(plante::kParams, groom.region_names.size());
-  params.set("wisps", style.wisps, {"reproduce", ""});
-  // The paper's wisp counts as they are: no splitting of wide wisps (as BM_PlanteStyle).
-  params.set("wisp_width_max", 1000, {"reproduce", ""});
-  ThreadPool pool(1);  // the paper's single R12000
-  plante::PlanteWispModel model(ModelContext{&pool});
-  model.reset(groom, params);
-  StageTimes times;
-  std::map<std::string, double> stage;
-  double total = 0.0;
-  for (int f = 0; f < frames; ++f) {
-    const FrameInput in = frame_input(shake, f);
-    times.clear();
-    const auto start = std::chrono::steady_clock::now();
-    model.step(in, times);
-    total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    for (const auto& e : times.entries()) stage[std::string(e.name)] += e.ms;
-  }
-  const auto& s = model.wisps();
-  const double interactions = stage["body_collision"] + stage["self_interaction"];
+  PlanteStyleTiming t = time_plante_style(style, frames);
+  const double interactions = t.stage_ms["body_collision"] + t.stage_ms["self_interaction"];
   PlanteResult r;
-  r.wisps = static_cast<double>(s.wisp_count());
-  r.segments = static_cast<double>(s.node_count() - s.wisp_count()) / r.wisps;
-  r.ms_per_sim_s = total / (frames * kFrameDt);
-  r.interaction_share = interactions / total;
-  r.self_of_interactions = interactions > 0.0 ? stage["self_interaction"] / interactions : kNaN;
+  r.wisps = t.wisps;
+  r.segments = t.segments_per_wisp;
+  r.ms_per_sim_s = t.step_ms / t.sim_s;
+  r.interaction_share = interactions / t.step_ms;
+  r.self_of_interactions = interactions > 0.0 ? t.stage_ms["self_interaction"] / interactions : kNaN;
   return r;
 }
 
@@ -616,8 +568,9 @@ json reproduce_plante(const Ctx& c) {
   std::map<std::string, double> hours;
   for (const json& row : t["rows"]) {
     const std::string name = row[0];
-    const PlanteStyle& style = *std::find_if(std::begin(kPlanteStyles), std::end(kPlanteStyles),
-                                             [&](const PlanteStyle& s) { return name == s.name; });
+    const auto styles = plante_styles();
+    const PlanteStyle& style =
+        *std::find_if(styles.begin(), styles.end(), [&](const PlanteStyle& s) { return name == s.name; });
     c.log("plante2001 §5.3: " + name);
     const PlanteResult r = res[name] = run_plante(style, frames);
     hours[name] = row[4];
