@@ -91,12 +91,12 @@ enum Stage : int { kIntegrate, kGlobal, kLocal, kLength, kCollision, kStageCount
 // Advances `count` (1..kMaxBlocks) blocks of one vertex count, method and parameter set
 // by one frame, side by side, and writes their positions to out (float4 per vertex).
 // Two blocks at a time give method 1's serial chains something to overlap with; scratch
-// holds count * scratch_floats(n) floats. With stage_ns non-null, adds the nanoseconds
-// spent in each Stage (a few clock reads per substep; callers pass it for a sample of
-// blocks only).
+// holds count * scratch_floats(n) floats. feed holds the next job's memory, requested
+// stage by stage. With stage_ns non-null, adds the nanoseconds spent in each Stage (a
+// few clock reads per substep; callers pass it for a sample of blocks only).
 inline constexpr int kMaxBlocks = 2;
 using FrameFn = void (*)(const Block* blocks, int count, const BlockParams& params, const Frame& frame, float* out,
-                         float* scratch, std::int64_t* stage_ns);
+                         float* scratch, soa::LineFeed& feed, std::int64_t* stage_ns);
 
 // The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline
 // build. Both give the same bits.

@@ -234,9 +234,19 @@ void global_shape(const Rows& r, const RowKind* kinds, int n, const Substep& s, 
     const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
     const float k = p.global_ramp ? p.global_stiffness * (1.0f - static_cast<float>(i) / p.global_reach)
                                   : p.global_stiffness;
-    const bool mixed = kinds[i] == kRowMixed;
+    // A free row moves every lane, with no test: with the test GCC 12 leaves this loop
+    // scalar (the select becomes a branch per lane).
+    if (kinds[i] == kRowFree) {
+      LANES {
+        const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
+        px[l] = px[l] + k * (gx - px[l]);
+        py[l] = py[l] + k * (gy - py[l]);
+        pz[l] = pz[l] + k * (gz - pz[l]);
+      }
+      continue;
+    }
     LANES {
-      const bool on = !mixed || iw[l] != 0.0f;
+      const bool on = iw[l] != 0.0f;
       const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
       px[l] = on ? px[l] + k * (gx - px[l]) : px[l];
       py[l] = on ? py[l] + k * (gy - py[l]) : py[l];
@@ -420,6 +430,8 @@ void edge_length(const Rows& r, int n) {
 
 // Sphere collisions (collide_spheres): up to four passes; a lane whose pass moved
 // nothing would move nothing in later passes either, so passes stop when no lane moved.
+// Most rows have no lane inside any sphere: one test of every sphere and one reduction
+// over the lanes skip them (a row outside every sphere is not moved by any pass).
 void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < n; ++i) {
@@ -427,6 +439,19 @@ void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
     const int o = i * W;
     float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
     const float* iw = r.iw + o;
+    alignas(64) int hit[W] = {};
+    for (int c = 0; c < s.sphere_count; ++c) {
+      const float cx = s.spheres[4 * c], cy = s.spheres[4 * c + 1], cz = s.spheres[4 * c + 2],
+                  cr = s.spheres[4 * c + 3];
+      LANES {
+        const float dx = px[l] - cx, dy = py[l] - cy, dz = pz[l] - cz;
+        const float d2 = dx * dx + (dy * dy + dz * dz);
+        hit[l] |= static_cast<int>((iw[l] != 0.0f) & (d2 < cr * cr));
+      }
+    }
+    int any = 0;
+    LANES { any |= hit[l]; }
+    if (!any) continue;
     for (int pass = 0; pass < kPasses; ++pass) {
       int moved = 0;
       for (int c = 0; c < s.sphere_count; ++c) {
@@ -518,7 +543,7 @@ struct Ctx {
 };
 
 void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f, float* out, float* scratch,
-           std::int64_t* stage_ns) {
+           soa::LineFeed& feed, std::int64_t* stage_ns) {
   const int n = blocks[0].n, method = blocks[0].method;
   const std::size_t rows = static_cast<std::size_t>(n) * W;
   Ctx c[kMaxBlocks];
@@ -542,9 +567,17 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
   const bool local_on = p.local_iterations > 0;
   const int iterations = p.local_iterations > p.length_iterations ? p.local_iterations : p.length_iterations;
   soa::StageClock clock(stage_ns);
+  // Each finished stage requests its share of the next job's lines.
+  const int per_substep = 1 + p.global_on + (local_on && method == 3) + p.local_iterations + p.length_iterations +
+                          (f.substep_count > 0 && f.substeps[0].sphere_count > 0);
+  feed.pace(local_on + f.substep_count * per_substep);
+  auto done = [&](Stage stage) {
+    clock.lap(stage);
+    feed.step();
+  };
   if (local_on) {
     for (int j = 0; j < count; ++j) mass_weights(c[j].r, n, c[j].ka, c[j].kb);
-    clock.lap(kLocal);
+    done(kLocal);
   }
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
@@ -554,14 +587,14 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
       else
         integrate<false>(c[j].r, c[j].kinds, n, s, f, p.keep);
     }
-    clock.lap(kIntegrate);
+    done(kIntegrate);
     if (p.global_on) {
       for (int j = 0; j < count; ++j) global_shape(c[j].r, c[j].kinds, n, s, p);
-      clock.lap(kGlobal);
+      done(kGlobal);
     }
     if (local_on && method == 3) {
       for (int j = 0; j < count; ++j) rest_edges_m3(c[j].r, n, s, c[j].scratch, c[j].scratch + rows, c[j].scratch + 2 * rows);
-      clock.lap(kLocal);
+      done(kLocal);
     }
     // Algorithm 1 lines 7-9: local shape and edge length alternate, each up to its count.
     for (int it = 0; it < iterations; ++it) {
@@ -581,19 +614,20 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
               local_m3(b.r, n, b.scratch, b.scratch + rows, b.scratch + 2 * rows, b.ka, b.kb, p.local_stiffness);
           }
         }
-        clock.lap(kLocal);
+        done(kLocal);
       }
       if (it < p.length_iterations) {
         for (int j = 0; j < count; ++j) edge_length(c[j].r, n);
-        clock.lap(kLength);
+        done(kLength);
       }
     }
     if (s.sphere_count > 0) {
       for (int j = 0; j < count; ++j) collide(c[j].r, c[j].kinds, n, s);
-      clock.lap(kCollision);
+      done(kCollision);
     }
   }
   for (int j = 0; j < count; ++j) write_back(c[j].r, n, blocks[j].out_offset, out);
+  feed.finish();
 }
 
 }  // namespace

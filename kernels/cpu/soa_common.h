@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 
 namespace hairbench::kernels::soa {
@@ -29,6 +30,48 @@ class StageClock {
   }
   std::int64_t* ns_;
   std::int64_t last_ = 0;
+};
+
+// The next job's memory, requested a few cache lines at a time while this job computes.
+// A block's rows are too short for the hardware prefetchers to ramp up, and one burst
+// of a few hundred prefetches fills the core's miss buffers and stalls the job's own
+// loads. Spread over the job, the lines arrive as this job's own lines are last used.
+class LineFeed {
+ public:
+  static constexpr int kMaxRanges = 40;
+  static constexpr std::size_t kLine = 64;
+
+  void clear() {
+    ranges_ = range_ = 0;
+    lines_ = 0;
+  }
+  // Adds [p, p + bytes); ranges past kMaxRanges are left to the hardware.
+  void add(const void* p, std::size_t bytes) {
+    if (ranges_ == kMaxRanges || bytes == 0) return;
+    const std::uintptr_t b = reinterpret_cast<std::uintptr_t>(p) & ~(kLine - 1);
+    const std::uintptr_t e = reinterpret_cast<std::uintptr_t>(p) + bytes;
+    begin_[ranges_] = b;
+    end_[ranges_] = e;
+    lines_ += (e - b + kLine - 1) / kLine;
+    if (ranges_++ == 0) cursor_ = b;
+  }
+  // Spreads the lines over `steps` calls of step().
+  void pace(int steps) { per_step_ = steps > 0 ? (lines_ + static_cast<std::size_t>(steps) - 1) / steps : lines_; }
+  void step() { issue(per_step_); }
+  void finish() { issue(lines_); }
+
+ private:
+  void issue(std::size_t k) {
+    for (; k > 0 && range_ < ranges_; --k) {
+      __builtin_prefetch(reinterpret_cast<const void*>(cursor_), 1, 3);
+      cursor_ += kLine;
+      if (cursor_ >= end_[range_] && ++range_ < ranges_) cursor_ = begin_[range_];
+    }
+  }
+  std::uintptr_t begin_[kMaxRanges], end_[kMaxRanges];
+  std::uintptr_t cursor_ = 0;
+  int ranges_ = 0, range_ = 0;
+  std::size_t lines_ = 0, per_step_ = 0;
 };
 
 // The head transform (row-major linear part m, translation t) in locals, so the

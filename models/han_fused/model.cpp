@@ -202,20 +202,15 @@ std::size_t HanFusedModel::state_bytes() const {
   return data_.size() * sizeof(float) + pos_.size() * sizeof(Vec4f);
 }
 
-// Asks for the next job's blocks and output lines while this job computes: a block is a
-// few kilobytes spread over pages, too little for the hardware prefetchers to ramp up.
-void HanFusedModel::prefetch(const Job& job) const {
-  constexpr std::size_t kLine = 64;
+// The next job's blocks and output lines, for the kernel to request while this job
+// computes (soa::LineFeed).
+void HanFusedModel::feed_job(const Job& job, kernels::soa::LineFeed& feed) const {
+  feed.clear();
   for (int i = 0; i < job.count; ++i) {
     const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
-    const char* d = reinterpret_cast<const char*>(data_.data() + b.offset);
-    const std::size_t bytes = soa::block_floats(b.method, b.n) * sizeof(float);
-    for (std::size_t o = 0; o < bytes; o += kLine) __builtin_prefetch(d + o, 1, 3);
-    for (int l = 0; l < W; ++l) {
-      if (b.out_offset[l] == soa::kNoStrand) continue;
-      const char* p = reinterpret_cast<const char*>(pos_.data() + b.out_offset[l]);
-      for (std::size_t o = 0; o < b.n * sizeof(Vec4f); o += kLine) __builtin_prefetch(p + o, 1, 3);
-    }
+    feed.add(data_.data() + b.offset, soa::block_floats(b.method, b.n) * sizeof(float));
+    for (int l = 0; l < W; ++l)
+      if (b.out_offset[l] != soa::kNoStrand) feed.add(pos_.data() + b.out_offset[l], b.n * sizeof(Vec4f));
   }
 }
 
@@ -224,6 +219,7 @@ void HanFusedModel::run_thread(int t) {
   float* out = pos_.data()->data();
   float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
   float* backup = backup_.data() + backup_stride_ * static_cast<std::size_t>(t);
+  kernels::soa::LineFeed feed;
   for (std::size_t j = ts.first; j < ts.last; ++j) {
     const Job& job = jobs_[j];
     const BlockInfo& first = blocks_[job.first];
@@ -247,12 +243,15 @@ void HanFusedModel::run_thread(int t) {
         const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
         std::copy_n(blocks[i].data, soa::block_floats(b.method, b.n), backup + i * backup_stride_ / soa::kMaxBlocks);
       }
-    if (j + 1 < ts.last) prefetch(jobs_[j + 1]);
+    if (j + 1 < ts.last)
+      feed_job(jobs_[j + 1], feed);
+    else
+      feed.clear();
     if (!job.sampled) {
-      kernel_(blocks, job.count, p, frame_, out, scratch, nullptr);
+      kernel_(blocks, job.count, p, frame_, out, scratch, feed, nullptr);
     } else {
       const auto start = std::chrono::steady_clock::now();
-      kernel_(blocks, job.count, p, frame_, out, scratch, ts.stage_ns.data());
+      kernel_(blocks, job.count, p, frame_, out, scratch, feed, ts.stage_ns.data());
       ts.sampled_ns +=
           std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
     }

@@ -59,7 +59,7 @@ class HanFusedModel final : public HairModel {
   };
   using ThreadState = BlockThread<kernels::han_soa::kStageCount>;
   void run_thread(int t);
-  void prefetch(const Job& job) const;
+  void feed_job(const Job& job, kernels::soa::LineFeed& feed) const;
   void observe_sleep(int t, float dt);
 
   han::Method method_;
