@@ -44,20 +44,6 @@ inline void quat_mul(const float* ax, const float* ay, const float* az, const fl
   }
 }
 
-// Eigen's Quaternion::normalized(): coefficients (x, y, z, w) divided by the root of
-// (x² + z²) + (y² + w²) (its SSE horizontal sum), unchanged when that is 0.
-inline void quat_normalize(Quat& q) {
-  LANES {
-    const float n2 = (q.x[l] * q.x[l] + q.z[l] * q.z[l]) + (q.y[l] * q.y[l] + q.w[l] * q.w[l]);
-    const float r = std::sqrt(n2);
-    const bool ok = n2 > 0.0f;
-    q.x[l] = ok ? q.x[l] / r : q.x[l];
-    q.y[l] = ok ? q.y[l] / r : q.y[l];
-    q.z[l] = ok ? q.z[l] / r : q.z[l];
-    q.w[l] = ok ? q.w[l] / r : q.w[l];
-  }
-}
-
 // q · v in Eigen's form: uv = q×v, uv += uv, v + w uv + q×uv.
 inline void rotate(float qx, float qy, float qz, float qw, float vx, float vy, float vz, float& ox, float& oy,
                    float& oz) {
@@ -92,14 +78,23 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
     r.z[l] = flip ? 1.0f : vy / s;
     r.w[l] = flip ? 0.0f : w / s;
   }
-  quat_mul(parent.x, parent.y, parent.z, parent.w, r.x, r.y, r.z, r.w, out);
-  quat_normalize(out);
+  Quat m;
+  quat_mul(parent.x, parent.y, parent.z, parent.w, r.x, r.y, r.z, r.w, m);
+  // Eigen's Quaternion::normalized(): coefficients (x, y, z, w) divided by the root of
+  // (x² + z²) + (y² + w²) (its SSE horizontal sum), unchanged when that is 0. Every lane
+  // of `out` is written from values in registers: a select that keeps some lanes of an
+  // array becomes a masked store, and the next edge's loads of the frame cannot take
+  // their values from a masked store still in the store queue (they wait for it).
   LANES {
-    const bool keep = ok[l] == 0.0f;
-    out.x[l] = keep ? parent.x[l] : out.x[l];
-    out.y[l] = keep ? parent.y[l] : out.y[l];
-    out.z[l] = keep ? parent.z[l] : out.z[l];
-    out.w[l] = keep ? parent.w[l] : out.w[l];
+    const float n2 = (m.x[l] * m.x[l] + m.z[l] * m.z[l]) + (m.y[l] * m.y[l] + m.w[l] * m.w[l]);
+    const float rn = std::sqrt(n2);
+    const bool scale = n2 > 0.0f, keep = ok[l] == 0.0f;
+    const float x = scale ? m.x[l] / rn : m.x[l], y = scale ? m.y[l] / rn : m.y[l],
+                z = scale ? m.z[l] / rn : m.z[l], w = scale ? m.w[l] / rn : m.w[l];
+    out.x[l] = keep ? parent.x[l] : x;
+    out.y[l] = keep ? parent.y[l] : y;
+    out.z[l] = keep ? parent.z[l] : z;
+    out.w[l] = keep ? parent.w[l] : w;
   }
 }
 
