@@ -58,6 +58,7 @@ inline void rotate(float qx, float qy, float qz, float qw, float vx, float vy, f
 
 // The frame of vertex i from its parent's frame and the edge (a, b): Algorithm 3, lines
 // 10-12, as kernels::child_frame (strand_kernels.cpp) with rotation_from_x (frames.h).
+// out may be parent (each lane reads its parent before its result is stored).
 inline void child_frame(const Quat& parent, const float* ax, const float* ay, const float* az, const float* bx,
                         const float* by, const float* bz, Quat& out) {
   Quat r;
@@ -310,7 +311,7 @@ void local_m1(const M1Block* blk, int n, const Substep& s, float stiffness) {
     hz[l] = s.q[2];
     hw[l] = s.q[3];
   }
-  Quat frame[C], next[C];
+  Quat frame[C];
   for (int j = 0; j < C; ++j) {
     const float* rr1 = blk[j].rest_frames + 4 * W;  // w, x, y, z rows of wR_1^0
     quat_mul(hx, hy, hz, hw, rr1 + W, rr1 + 2 * W, rr1 + 3 * W, rr1, frame[j]);
@@ -330,9 +331,8 @@ void local_m1(const M1Block* blk, int n, const Substep& s, float stiffness) {
       }
       local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, k.ka + b, k.kb + b,
                  gx[j], gy[j], gz[j], stiffness);
-      child_frame(frame[j], r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, next[j]);
+      child_frame(frame[j], r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, frame[j]);
     }
-    for (int j = 0; j < C; ++j) frame[j] = next[j];
   }
 }
 
