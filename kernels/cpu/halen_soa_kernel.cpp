@@ -30,8 +30,10 @@ struct Rows {
   const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
 };
 
-// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest.
-void follow_head(const Rows& r, const soa::AffinePose& h) {
+// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest. The pose
+// is taken by value: through a reference the compiler must assume the row stores may
+// change it, and leaves the lane loop scalar.
+void follow_head(const Rows& r, const soa::AffinePose h) {
   for (int i = 0; i < r.n; ++i) {
     if (r.kind[i] == kRowFree) continue;
     const int o = i * W;
@@ -139,7 +141,8 @@ void edge_length(const Rows& r) {
 // any sphere; a vertex outside every sphere is not moved by any pass. The few inside
 // take the per-strand kernel's passes one lane at a time: a push (a root and three
 // divisions) for sixteen lanes costs more than the scalar pushes of the lanes that need
-// one.
+// one. The test accumulates into every lane with bitwise operations (no branch, no
+// reduction per sphere), so it stays one vector loop per sphere; the row is reduced once.
 void collide(const Rows& r, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < r.n; ++i) {
@@ -147,18 +150,22 @@ void collide(const Rows& r, const Substep& s) {
     const int o = i * W;
     const float* iw = r.field(IW, i);
     float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
-    alignas(64) int hit[W] = {};
-    int any = 0;
+    alignas(64) int hit[W];
+    LANES { hit[l] = 0; }
     for (int c = 0; c < s.sphere_count; ++c) {
       const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
                   rad = s.spheres[4 * c + 3];
+      const float rad2 = rad * rad;
       LANES {
         const float dx = px[l] - sx, dy = py[l] - sy, dz = pz[l] - sz;
         const float dist2 = dx * dx + (dy * dy + dz * dz);
-        const int in = iw[l] != 0.0f && !(dist2 >= rad * rad);
-        hit[l] |= in;
-        any |= in;
+        hit[l] |= static_cast<int>(!(dist2 >= rad2));
       }
+    }
+    int any = 0;
+    LANES {
+      hit[l] &= static_cast<int>(iw[l] != 0.0f);
+      any |= hit[l];
     }
     if (!any) continue;
     for (int l = 0; l < W; ++l) {
