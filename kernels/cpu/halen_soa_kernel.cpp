@@ -6,6 +6,8 @@
 #include "kernels/cpu/soa_common.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #ifndef HALEN_SOA_VARIANT
 #error "HALEN_SOA_VARIANT must name the ISA variant"
@@ -142,7 +144,9 @@ void edge_length(const Rows& r) {
 // take the per-strand kernel's passes one lane at a time: a push (a root and three
 // divisions) for sixteen lanes costs more than the scalar pushes of the lanes that need
 // one. The test accumulates into every lane with bitwise operations (no branch, no
-// reduction per sphere), so it stays one vector loop per sphere; the row is reduced once.
+// reduction per sphere), so it stays one vector loop per sphere; the row is reduced once,
+// as bytes read back in 8-byte words (an OR reduction over int lanes compiles to one
+// extract per lane).
 void collide(const Rows& r, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < r.n; ++i) {
@@ -162,14 +166,17 @@ void collide(const Rows& r, const Substep& s) {
         hit[l] |= static_cast<int>(!(dist2 >= rad2));
       }
     }
-    int any = 0;
-    LANES {
-      hit[l] &= static_cast<int>(iw[l] != 0.0f);
-      any |= hit[l];
+    alignas(64) std::uint8_t in[W];
+    LANES { in[l] = static_cast<std::uint8_t>(hit[l] & static_cast<int>(iw[l] != 0.0f)); }
+    std::uint64_t any = 0;
+    for (int w = 0; w < W; w += 8) {
+      std::uint64_t word;
+      std::memcpy(&word, in + w, sizeof word);
+      any |= word;
     }
     if (!any) continue;
     for (int l = 0; l < W; ++l) {
-      if (!hit[l]) continue;
+      if (!in[l]) continue;
       float x = px[l], y = py[l], z = pz[l];
       for (int pass = 0; pass < kPasses; ++pass) {
         bool moved = false;
