@@ -36,8 +36,8 @@ struct Rows {
   const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
 };
 
-// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest. The pose
-// is taken by value: through a reference the compiler must assume the row stores may
+// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest; the
+// cascade's, before its references read the moved roots. The pose is taken by value: through a reference the compiler must assume the row stores may
 // change it, and leaves the lane loop scalar.
 void follow_head(const Rows& r, const soa::AffinePose h) {
   for (int i = 0; i < r.n; ++i) {
@@ -58,25 +58,79 @@ void follow_head(const Rows& r, const soa::AffinePose h) {
   }
 }
 
-// Verlet with damping (verlet_integrate), row by row from vertex 1, so the wind term sees
-// vertex i-1 already moved, as in the per-strand kernel.
-template <bool kWindy>
-void verlet(const Rows& r, const Frame& f, float keep, float dt2) {
-  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
-  [[maybe_unused]] const float wx = f.wind[0], wy = f.wind[1], wz = f.wind[2];
+// One substep's integration, row by row; every stage of the per-strand kernels reads only
+// its own row, so they run fused on a row while it is in registers: for the spring model
+// the reference node rigid with the head, lifted against gravity (§4.4, head_references)
+// and follow_head; then Verlet with damping (verlet_integrate) from vertex 1, and the
+// zero-rest-length springs towards the reference nodes (add_spring_acceleration), the
+// cascade's upward then downward ones (§4.3): p += (scale k dt²)(ref - p_start). The one
+// read across rows is the wind term's, which sees vertex i-1 as Verlet left it, before its
+// springs: that row is kept aside. Rows whose lanes are all free or all pinned take no
+// per-lane selects.
+struct Integration {
+  soa::AffinePose h;
+  float gx, gy, gz, wx, wy, wz;
+  float keep, dt2;
+  float scale;  // the spring model's tilt factor, 1 for the cascade
+};
+
+// Vertex i-1 after Verlet, before its springs (the wind term's).
+struct Moved {
+  alignas(64) float x[W], y[W], z[W];
+};
+
+template <Model kModel, bool kWindy, RowKind kKind, bool kRoot>
+inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
+  constexpr bool kSpring = kModel == Model::Spring;
+  const soa::AffinePose h = in.h;
+  const float gx = in.gx, gy = in.gy, gz = in.gz, keep = in.keep, dt2 = in.dt2, scale = in.scale;
+  [[maybe_unused]] const float wx = in.wx, wy = in.wy, wz = in.wz;
   const float gdx = gx * dt2, gdy = gy * dt2, gdz = gz * dt2;
-  for (int i = 1; i < r.n; ++i) {
-    if (r.kind[i] == kRowPinned) continue;
-    const int o = i * W;
-    const float* iw = r.field(IW, i);
-    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
-    const float *ax = px - W, *ay = py - W, *az = pz - W;
-    LANES {
-      const bool free = iw[l] != 0.0f;
-      const float x = px[l], y = py[l], z = pz[l];
+  const int o = i * W;
+  const float *rx = r.field(RX, i), *ry = r.field(RY, i), *rz = r.field(RZ, i), *iw = r.field(IW, i);
+  float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+  float *mx = m.x, *my = m.y, *mz = m.z;
+  if constexpr (kKind == kRowPinned) {
+    if constexpr (kSpring)
+      LANES {
+        const float x = px[l], y = py[l], z = pz[l];
+        px[l] = h.x(rx[l], ry[l], rz[l]);
+        py[l] = h.y(rx[l], ry[l], rz[l]);
+        pz[l] = h.z(rx[l], ry[l], rz[l]);
+        qx[l] = x;
+        qy[l] = y;
+        qz[l] = z;
+      }
+    if constexpr (kWindy)
+      LANES {
+        mx[l] = px[l];
+        my[l] = py[l];
+        mz[l] = pz[l];
+      }
+    return;
+  }
+  const float *lift = r.field(LIFT, i), *ku = r.field(KU, i);
+  const float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
+  // The cascade's downward springs: only rows with a segment two below them.
+  const bool down = !kSpring && i + 2 < r.n;
+  const float* kd = kSpring ? ku : r.field(KD, i);
+  const float *dx = r.dx + o, *dy = r.dy + o, *dz = r.dz + o;
+  LANES {
+    const bool free = kKind == kRowFree || iw[l] != 0.0f;
+    const float x = px[l], y = py[l], z = pz[l];
+    float nx = x, ny = y, nz = z, ox = qx[l], oy = qy[l], oz = qz[l];
+    if constexpr (kSpring && kKind == kRowMixed) {  // follow_head
+      nx = free ? x : h.x(rx[l], ry[l], rz[l]);
+      ny = free ? y : h.y(rx[l], ry[l], rz[l]);
+      nz = free ? z : h.z(rx[l], ry[l], rz[l]);
+      ox = free ? ox : x;
+      oy = free ? oy : y;
+      oz = free ? oz : z;
+    }
+    if constexpr (!kRoot) {  // verlet_integrate
       float ddx = gdx, ddy = gdy, ddz = gdz;
       if constexpr (kWindy) {
-        const float ex = x - ax[l], ey = y - ay[l], ez = z - az[l];
+        const float ex = x - mx[l], ey = y - my[l], ez = z - mz[l];
         const float len2 = ex * ex + (ey * ey + ez * ez);
         const float len = std::sqrt(len2);
         const bool ok = len2 > 0.0f;
@@ -86,35 +140,68 @@ void verlet(const Rows& r, const Frame& f, float keep, float dt2) {
         ddy = (gy + (wy - dw * ty)) * dt2;
         ddz = (gz + (wz - dw * tz)) * dt2;
       }
-      px[l] = free ? (x + keep * (x - qx[l])) + ddx : x;
-      py[l] = free ? (y + keep * (y - qy[l])) + ddy : y;
-      pz[l] = free ? (z + keep * (z - qz[l])) + ddz : z;
-      qx[l] = free ? x : qx[l];
-      qy[l] = free ? y : qy[l];
-      qz[l] = free ? z : qz[l];
+      nx = free ? (x + keep * (x - ox)) + ddx : nx;
+      ny = free ? (y + keep * (y - oy)) + ddy : ny;
+      nz = free ? (z + keep * (z - oz)) + ddz : nz;
+      ox = free ? x : ox;
+      oy = free ? y : oy;
+      oz = free ? z : oz;
     }
+    if constexpr (kWindy) {
+      mx[l] = nx;
+      my[l] = ny;
+      mz[l] = nz;
+    }
+    float ax, ay, az;  // the reference node
+    if constexpr (kSpring) {
+      ax = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];
+      ay = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
+      az = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
+    } else {
+      ax = ux[l];
+      ay = uy[l];
+      az = uz[l];
+    }
+    const float c = (scale * ku[l]) * dt2;
+    nx = free ? nx + c * (ax - ox) : nx;
+    ny = free ? ny + c * (ay - oy) : ny;
+    nz = free ? nz + c * (az - oz) : nz;
+    if constexpr (!kSpring) {
+      const bool on = free && down;
+      const float cd = (scale * kd[l]) * dt2;
+      nx = on ? nx + cd * (dx[l] - ox) : nx;
+      ny = on ? ny + cd * (dy[l] - oy) : ny;
+      nz = on ? nz + cd * (dz[l] - oz) : nz;
+    }
+    px[l] = nx;
+    py[l] = ny;
+    pz[l] = nz;
+    qx[l] = ox;
+    qy[l] = oy;
+    qz[l] = oz;
   }
 }
 
-// Zero-rest-length springs (add_spring_acceleration) towards the reference nodes
-// (rx, ry, rz) with stiffness field `kf`, on rows [0, end): p += (scale k dt²)(ref - p_start).
-void springs(const Rows& r, int kf, const float* rx, const float* ry, const float* rz, int end, float scale,
-             float dt2) {
-  for (int i = 0; i < end; ++i) {
-    if (r.kind[i] == kRowPinned) continue;
-    const int o = i * W;
-    const float *iw = r.field(IW, i), *k = r.field(kf, i);
-    const float *ax = rx + o, *ay = ry + o, *az = rz + o;
-    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
-    const float *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
-    LANES {
-      const bool free = iw[l] != 0.0f;
-      const float c = (scale * k[l]) * dt2;
-      px[l] = free ? px[l] + c * (ax[l] - qx[l]) : px[l];
-      py[l] = free ? py[l] + c * (ay[l] - qy[l]) : py[l];
-      pz[l] = free ? pz[l] + c * (az[l] - qz[l]) : pz[l];
-    }
+template <Model kModel, bool kWindy, bool kRoot>
+inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
+  switch (r.kind[i]) {
+    case kRowFree:
+      integrate_row<kModel, kWindy, kRowFree, kRoot>(r, i, in, m);
+      break;
+    case kRowPinned:
+      integrate_row<kModel, kWindy, kRowPinned, kRoot>(r, i, in, m);
+      break;
+    default:
+      integrate_row<kModel, kWindy, kRowMixed, kRoot>(r, i, in, m);
+      break;
   }
+}
+
+template <Model kModel, bool kWindy>
+void integrate(const Rows& r, const Integration& in) {
+  Moved m;
+  integrate_row<kModel, kWindy, true>(r, 0, in, m);  // the integrator starts at vertex 1
+  for (int i = 1; i < r.n; ++i) integrate_row<kModel, kWindy, false>(r, i, in, m);
 }
 
 // Edge length constraints (edge_length): odd edges, then even ones, mass-weighted.
@@ -203,21 +290,6 @@ void collide(const Rows& r, const Substep& s) {
       px[l] = x;
       py[l] = y;
       pz[l] = z;
-    }
-  }
-}
-
-// §4.4: reference nodes rigid with the head, lifted against gravity (head_references).
-void spring_references(const Rows& r, const soa::AffinePose& h, const Frame& f) {
-  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
-  for (int i = 0; i < r.n; ++i) {
-    const int o = i * W;
-    const float *rx = r.field(RX, i), *ry = r.field(RY, i), *rz = r.field(RZ, i), *lift = r.field(LIFT, i);
-    float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
-    LANES {
-      ux[l] = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];
-      uy[l] = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
-      uz[l] = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
     }
   }
 }
@@ -381,25 +453,17 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
     const soa::AffinePose h(s.m, s.t);
-    if constexpr (kModel == Model::Spring) {
-      spring_references(r, h, f);
-      clock.lap(kReferences);
-      follow_head(r, h);
-    } else {
+    if constexpr (kModel == Model::Cascade) {
       follow_head(r, h);
       cascade_references(r, s, f);
-      clock.lap(kReferences);
+      clock.lap(kReferences);  // the spring model's references are computed in its integration
     }
+    const Integration in{h,      f.gravity[0], f.gravity[1], f.gravity[2], f.wind[0], f.wind[1], f.wind[2],
+                         p.keep, s.dt2,        kModel == Model::Spring ? p.spring_scale[k] : 1.0f};
     if (f.windy)
-      verlet<true>(r, f, p.keep, s.dt2);
+      integrate<kModel, true>(r, in);
     else
-      verlet<false>(r, f, p.keep, s.dt2);
-    if constexpr (kModel == Model::Spring) {
-      springs(r, KU, r.ux, r.uy, r.uz, n, p.spring_scale[k], s.dt2);
-    } else {
-      springs(r, KU, r.ux, r.uy, r.uz, n, 1.0f, s.dt2);
-      springs(r, KD, r.dx, r.dy, r.dz, n - 2, 1.0f, s.dt2);
-    }
+      integrate<kModel, false>(r, in);
     clock.lap(kIntegrate);
     for (int it = 0; it < p.length_iterations; ++it) edge_length(r);
     clock.lap(kLength);
