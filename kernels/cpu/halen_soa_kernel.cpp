@@ -79,7 +79,9 @@ struct Moved {
   alignas(64) float x[W], y[W], z[W];
 };
 
-template <Model kModel, bool kWindy, RowKind kKind, bool kRoot>
+// kDown: the row has a downward spring (the cascade's rows with a segment two below them);
+// a template argument, as a run-time flag in the lane loop costs a mask built bit by bit.
+template <Model kModel, bool kWindy, RowKind kKind, bool kRoot, bool kDown>
 inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
   constexpr bool kSpring = kModel == Model::Spring;
   const soa::AffinePose h = in.h;
@@ -111,8 +113,6 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
   }
   const float *lift = r.field(LIFT, i), *ku = r.field(KU, i);
   const float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
-  // The cascade's downward springs: only rows with a segment two below them.
-  const bool down = !kSpring && i + 2 < r.n;
   const float* kd = kSpring ? ku : r.field(KD, i);
   const float *dx = r.dx + o, *dy = r.dy + o, *dz = r.dz + o;
   LANES {
@@ -166,12 +166,11 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
     nx = free ? nx + c * (ax - ox) : nx;
     ny = free ? ny + c * (ay - oy) : ny;
     nz = free ? nz + c * (az - oz) : nz;
-    if constexpr (!kSpring) {
-      const bool on = free && down;
+    if constexpr (kDown) {
       const float cd = (scale * kd[l]) * dt2;
-      nx = on ? nx + cd * (dx[l] - ox) : nx;
-      ny = on ? ny + cd * (dy[l] - oy) : ny;
-      nz = on ? nz + cd * (dz[l] - oz) : nz;
+      nx = free ? nx + cd * (dx[l] - ox) : nx;
+      ny = free ? ny + cd * (dy[l] - oy) : ny;
+      nz = free ? nz + cd * (dz[l] - oz) : nz;
     }
     px[l] = nx;
     py[l] = ny;
@@ -182,26 +181,34 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
   }
 }
 
-template <Model kModel, bool kWindy, bool kRoot>
+template <Model kModel, bool kWindy, bool kRoot, bool kDown>
 inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
   switch (r.kind[i]) {
     case kRowFree:
-      integrate_row<kModel, kWindy, kRowFree, kRoot>(r, i, in, m);
+      integrate_row<kModel, kWindy, kRowFree, kRoot, kDown>(r, i, in, m);
       break;
     case kRowPinned:
-      integrate_row<kModel, kWindy, kRowPinned, kRoot>(r, i, in, m);
+      integrate_row<kModel, kWindy, kRowPinned, kRoot, kDown>(r, i, in, m);
       break;
     default:
-      integrate_row<kModel, kWindy, kRowMixed, kRoot>(r, i, in, m);
+      integrate_row<kModel, kWindy, kRowMixed, kRoot, kDown>(r, i, in, m);
       break;
   }
 }
 
 template <Model kModel, bool kWindy>
 void integrate(const Rows& r, const Integration& in) {
+  constexpr bool kCascade = kModel == Model::Cascade;
   Moved m;
-  integrate_row<kModel, kWindy, true>(r, 0, in, m);  // the integrator starts at vertex 1
-  for (int i = 1; i < r.n; ++i) integrate_row<kModel, kWindy, false>(r, i, in, m);
+  // The integrator starts at vertex 1.
+  if (r.n > 2)
+    integrate_row<kModel, kWindy, true, kCascade>(r, 0, in, m);
+  else
+    integrate_row<kModel, kWindy, true, false>(r, 0, in, m);
+  const int down_end = kCascade ? r.n - 2 : 1;  // rows [1, down_end) have a downward spring
+  int i = 1;
+  for (; i < down_end; ++i) integrate_row<kModel, kWindy, false, kCascade>(r, i, in, m);
+  for (; i < r.n; ++i) integrate_row<kModel, kWindy, false, false>(r, i, in, m);
 }
 
 // Edge length constraints (edge_length): odd edges, then even ones, mass-weighted.
@@ -326,12 +333,13 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
   const int n = r.n;
   const float* rest_space = r.c + static_cast<std::size_t>(kCascadeFields) * n * W;
   // The root segment's space, rigid with the head: head rotation · rest space.
-  Space parent;
+  // sp[0] the root's; then row i's parent is sp[i & 1] and its space goes to the other.
+  Space sp[2];
   for (int col = 0; col < 3; ++col)
     for (int row = 0; row < 3; ++row) {
       const float h0 = s.m[3 * row], h1 = s.m[3 * row + 1], h2 = s.m[3 * row + 2];
       const float *s0 = rest_space + (3 * col) * W, *s1 = s0 + W, *s2 = s1 + W;
-      float* out = parent.v[3 * col + row];
+      float* out = sp[0].v[3 * col + row];
       LANES { out[l] = h0 * s0[l] + (h1 * s1[l] + h2 * s2[l]); }
     }
   // Rows 0 and 1 have no upward reference node; their springs have k = 0 and pull
@@ -352,12 +360,17 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
     place(m, r.field(DX, i), r.field(DY, i), r.field(DZ, i), r.px + p, r.py + p, r.pz + p, r.field(LIFT, i), f,
           r.dx + o, r.dy + o, r.dz + o);
   };
-  if (n > 2) up(parent, 2);
-  Space cur;
+  if (n > 2) up(sp[0], 2);
   for (int i = 2; i < n; ++i) {
+    const Space& parent = sp[i & 1];
+    Space& cur = sp[(i + 1) & 1];
     const int o = i * W;
     const float *ax = r.px + o - W, *ay = r.py + o - W, *az = r.pz + o - W;
     const float *bx = r.px + o, *by = r.py + o, *bz = r.pz + o;
+    // B = N × T_{n-1} normalised; where N is (nearly) parallel to the parent's T, B_{n-1}
+    // made perpendicular to N instead. That case is rare: it is computed, for the lanes
+    // in it, only in rows that have one (two roots and three divisions saved per row).
+    alignas(64) int narrow[W];
     LANES {
       const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
       const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
@@ -366,19 +379,13 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
       const float Tx = parent.v[6][l], Ty = parent.v[7][l], Tz = parent.v[8][l];
       float b0 = ny * Tz - nz * Ty, b1 = nz * Tx - nx * Tz, b2 = nx * Ty - ny * Tx;
       const float bl = std::sqrt(b0 * b0 + (b1 * b1 + b2 * b2));
-      // N parallel to the parent's T: B_{n-1} made perpendicular to N.
-      const float Bx = parent.v[0][l], By = parent.v[1][l], Bz = parent.v[2][l];
-      const float dot = Bx * nx + (By * ny + Bz * nz);
-      const float vx = Bx - dot * nx, vy = By - dot * ny, vz = Bz - dot * nz;
-      const float vn2 = vx * vx + (vy * vy + vz * vz);
-      const float vn = std::sqrt(vn2);
-      const bool wide = bl > 1e-6f;
-      b0 = wide ? b0 / bl : vn2 > 0.0f ? vx / vn : vx;
-      b1 = wide ? b1 / bl : vn2 > 0.0f ? vy / vn : vy;
-      b2 = wide ? b2 / bl : vn2 > 0.0f ? vz / vn : vz;
-      cur.v[0][l] = ok ? b0 : Bx;
-      cur.v[1][l] = ok ? b1 : By;
-      cur.v[2][l] = ok ? b2 : Bz;
+      b0 = b0 / bl;
+      b1 = b1 / bl;
+      b2 = b2 / bl;
+      narrow[l] = static_cast<int>(ok) & static_cast<int>(!(bl > 1e-6f));
+      cur.v[0][l] = ok ? b0 : parent.v[0][l];
+      cur.v[1][l] = ok ? b1 : parent.v[1][l];
+      cur.v[2][l] = ok ? b2 : parent.v[2][l];
       cur.v[3][l] = ok ? nx : parent.v[3][l];
       cur.v[4][l] = ok ? ny : parent.v[4][l];
       cur.v[5][l] = ok ? nz : parent.v[5][l];
@@ -386,9 +393,25 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
       cur.v[7][l] = ok ? nz * b0 - nx * b2 : Ty;
       cur.v[8][l] = ok ? nx * b1 - ny * b0 : Tz;
     }
+    if (any_lane(narrow))
+      LANES {
+        const bool on = narrow[l] != 0;
+        const float nx = cur.v[3][l], ny = cur.v[4][l], nz = cur.v[5][l];
+        const float Bx = parent.v[0][l], By = parent.v[1][l], Bz = parent.v[2][l];
+        const float dot = Bx * nx + (By * ny + Bz * nz);
+        const float vx = Bx - dot * nx, vy = By - dot * ny, vz = Bz - dot * nz;
+        const float vn2 = vx * vx + (vy * vy + vz * vz);
+        const float vn = std::sqrt(vn2);
+        const float b0 = vn2 > 0.0f ? vx / vn : vx, b1 = vn2 > 0.0f ? vy / vn : vy, b2 = vn2 > 0.0f ? vz / vn : vz;
+        cur.v[0][l] = on ? b0 : cur.v[0][l];
+        cur.v[1][l] = on ? b1 : cur.v[1][l];
+        cur.v[2][l] = on ? b2 : cur.v[2][l];
+        cur.v[6][l] = on ? ny * b2 - nz * b1 : cur.v[6][l];
+        cur.v[7][l] = on ? nz * b0 - nx * b2 : cur.v[7][l];
+        cur.v[8][l] = on ? nx * b1 - ny * b0 : cur.v[8][l];
+      }
     if (i + 1 < n) up(cur, i + 1);
     down(cur, i - 2);
-    parent = cur;
   }
 }
 
