@@ -6,6 +6,12 @@
 #include "kernels/cpu/soa_common.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #ifndef HALEN_SOA_VARIANT
 #error "HALEN_SOA_VARIANT must name the ISA variant"
@@ -30,8 +36,10 @@ struct Rows {
   const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
 };
 
-// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest.
-void follow_head(const Rows& r, const soa::AffinePose& h) {
+// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest; the
+// cascade's, before its references read the moved roots. The pose is taken by value: through a reference the compiler must assume the row stores may
+// change it, and leaves the lane loop scalar.
+void follow_head(const Rows& r, const soa::AffinePose h) {
   for (int i = 0; i < r.n; ++i) {
     if (r.kind[i] == kRowFree) continue;
     const int o = i * W;
@@ -50,25 +58,79 @@ void follow_head(const Rows& r, const soa::AffinePose& h) {
   }
 }
 
-// Verlet with damping (verlet_integrate), row by row from vertex 1, so the wind term sees
-// vertex i-1 already moved, as in the per-strand kernel.
-template <bool kWindy>
-void verlet(const Rows& r, const Frame& f, float keep, float dt2) {
-  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
-  [[maybe_unused]] const float wx = f.wind[0], wy = f.wind[1], wz = f.wind[2];
+// One substep's integration, row by row; every stage of the per-strand kernels reads only
+// its own row, so they run fused on a row while it is in registers: for the spring model
+// the reference node rigid with the head, lifted against gravity (§4.4, head_references)
+// and follow_head; then Verlet with damping (verlet_integrate) from vertex 1, and the
+// zero-rest-length springs towards the reference nodes (add_spring_acceleration), the
+// cascade's upward then downward ones (§4.3): p += (scale k dt²)(ref - p_start). The one
+// read across rows is the wind term's, which sees vertex i-1 as Verlet left it, before its
+// springs: that row is kept aside. Rows whose lanes are all free or all pinned take no
+// per-lane selects.
+struct Integration {
+  soa::AffinePose h;
+  float gx, gy, gz, wx, wy, wz;
+  float keep, dt2;
+  float scale;  // the spring model's tilt factor, 1 for the cascade
+};
+
+// Vertex i-1 after Verlet, before its springs (the wind term's).
+struct Moved {
+  alignas(64) float x[W], y[W], z[W];
+};
+
+// kDown: the row has a downward spring (the cascade's rows with a segment two below them);
+// a template argument, as a run-time flag in the lane loop costs a mask built bit by bit.
+template <Model kModel, bool kWindy, RowKind kKind, bool kRoot, bool kDown>
+inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
+  constexpr bool kSpring = kModel == Model::Spring;
+  const soa::AffinePose h = in.h;
+  const float gx = in.gx, gy = in.gy, gz = in.gz, keep = in.keep, dt2 = in.dt2, scale = in.scale;
+  [[maybe_unused]] const float wx = in.wx, wy = in.wy, wz = in.wz;
   const float gdx = gx * dt2, gdy = gy * dt2, gdz = gz * dt2;
-  for (int i = 1; i < r.n; ++i) {
-    if (r.kind[i] == kRowPinned) continue;
-    const int o = i * W;
-    const float* iw = r.field(IW, i);
-    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
-    const float *ax = px - W, *ay = py - W, *az = pz - W;
-    LANES {
-      const bool free = iw[l] != 0.0f;
-      const float x = px[l], y = py[l], z = pz[l];
+  const int o = i * W;
+  const float *rx = r.field(RX, i), *ry = r.field(RY, i), *rz = r.field(RZ, i), *iw = r.field(IW, i);
+  float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+  float *mx = m.x, *my = m.y, *mz = m.z;
+  if constexpr (kKind == kRowPinned) {
+    if constexpr (kSpring)
+      LANES {
+        const float x = px[l], y = py[l], z = pz[l];
+        px[l] = h.x(rx[l], ry[l], rz[l]);
+        py[l] = h.y(rx[l], ry[l], rz[l]);
+        pz[l] = h.z(rx[l], ry[l], rz[l]);
+        qx[l] = x;
+        qy[l] = y;
+        qz[l] = z;
+      }
+    if constexpr (kWindy)
+      LANES {
+        mx[l] = px[l];
+        my[l] = py[l];
+        mz[l] = pz[l];
+      }
+    return;
+  }
+  const float *lift = r.field(LIFT, i), *ku = r.field(KU, i);
+  const float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
+  const float* kd = kSpring ? ku : r.field(KD, i);
+  const float *dx = r.dx + o, *dy = r.dy + o, *dz = r.dz + o;
+  LANES {
+    const bool free = kKind == kRowFree || iw[l] != 0.0f;
+    const float x = px[l], y = py[l], z = pz[l];
+    float nx = x, ny = y, nz = z, ox = qx[l], oy = qy[l], oz = qz[l];
+    if constexpr (kSpring && kKind == kRowMixed) {  // follow_head
+      nx = free ? x : h.x(rx[l], ry[l], rz[l]);
+      ny = free ? y : h.y(rx[l], ry[l], rz[l]);
+      nz = free ? z : h.z(rx[l], ry[l], rz[l]);
+      ox = free ? ox : x;
+      oy = free ? oy : y;
+      oz = free ? oz : z;
+    }
+    if constexpr (!kRoot) {  // verlet_integrate
       float ddx = gdx, ddy = gdy, ddz = gdz;
       if constexpr (kWindy) {
-        const float ex = x - ax[l], ey = y - ay[l], ez = z - az[l];
+        const float ex = x - mx[l], ey = y - my[l], ez = z - mz[l];
         const float len2 = ex * ex + (ey * ey + ez * ez);
         const float len = std::sqrt(len2);
         const bool ok = len2 > 0.0f;
@@ -78,35 +140,75 @@ void verlet(const Rows& r, const Frame& f, float keep, float dt2) {
         ddy = (gy + (wy - dw * ty)) * dt2;
         ddz = (gz + (wz - dw * tz)) * dt2;
       }
-      px[l] = free ? (x + keep * (x - qx[l])) + ddx : x;
-      py[l] = free ? (y + keep * (y - qy[l])) + ddy : y;
-      pz[l] = free ? (z + keep * (z - qz[l])) + ddz : z;
-      qx[l] = free ? x : qx[l];
-      qy[l] = free ? y : qy[l];
-      qz[l] = free ? z : qz[l];
+      nx = free ? (x + keep * (x - ox)) + ddx : nx;
+      ny = free ? (y + keep * (y - oy)) + ddy : ny;
+      nz = free ? (z + keep * (z - oz)) + ddz : nz;
+      ox = free ? x : ox;
+      oy = free ? y : oy;
+      oz = free ? z : oz;
     }
+    if constexpr (kWindy) {
+      mx[l] = nx;
+      my[l] = ny;
+      mz[l] = nz;
+    }
+    float ax, ay, az;  // the reference node
+    if constexpr (kSpring) {
+      ax = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];
+      ay = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
+      az = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
+    } else {
+      ax = ux[l];
+      ay = uy[l];
+      az = uz[l];
+    }
+    const float c = (scale * ku[l]) * dt2;
+    nx = free ? nx + c * (ax - ox) : nx;
+    ny = free ? ny + c * (ay - oy) : ny;
+    nz = free ? nz + c * (az - oz) : nz;
+    if constexpr (kDown) {
+      const float cd = (scale * kd[l]) * dt2;
+      nx = free ? nx + cd * (dx[l] - ox) : nx;
+      ny = free ? ny + cd * (dy[l] - oy) : ny;
+      nz = free ? nz + cd * (dz[l] - oz) : nz;
+    }
+    px[l] = nx;
+    py[l] = ny;
+    pz[l] = nz;
+    qx[l] = ox;
+    qy[l] = oy;
+    qz[l] = oz;
   }
 }
 
-// Zero-rest-length springs (add_spring_acceleration) towards the reference nodes
-// (rx, ry, rz) with stiffness field `kf`, on rows [0, end): p += (scale k dt²)(ref - p_start).
-void springs(const Rows& r, int kf, const float* rx, const float* ry, const float* rz, int end, float scale,
-             float dt2) {
-  for (int i = 0; i < end; ++i) {
-    if (r.kind[i] == kRowPinned) continue;
-    const int o = i * W;
-    const float *iw = r.field(IW, i), *k = r.field(kf, i);
-    const float *ax = rx + o, *ay = ry + o, *az = rz + o;
-    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
-    const float *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
-    LANES {
-      const bool free = iw[l] != 0.0f;
-      const float c = (scale * k[l]) * dt2;
-      px[l] = free ? px[l] + c * (ax[l] - qx[l]) : px[l];
-      py[l] = free ? py[l] + c * (ay[l] - qy[l]) : py[l];
-      pz[l] = free ? pz[l] + c * (az[l] - qz[l]) : pz[l];
-    }
+template <Model kModel, bool kWindy, bool kRoot, bool kDown>
+inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
+  switch (r.kind[i]) {
+    case kRowFree:
+      integrate_row<kModel, kWindy, kRowFree, kRoot, kDown>(r, i, in, m);
+      break;
+    case kRowPinned:
+      integrate_row<kModel, kWindy, kRowPinned, kRoot, kDown>(r, i, in, m);
+      break;
+    default:
+      integrate_row<kModel, kWindy, kRowMixed, kRoot, kDown>(r, i, in, m);
+      break;
   }
+}
+
+template <Model kModel, bool kWindy>
+void integrate(const Rows& r, const Integration& in) {
+  constexpr bool kCascade = kModel == Model::Cascade;
+  Moved m;
+  // The integrator starts at vertex 1.
+  if (r.n > 2)
+    integrate_row<kModel, kWindy, true, kCascade>(r, 0, in, m);
+  else
+    integrate_row<kModel, kWindy, true, false>(r, 0, in, m);
+  const int down_end = kCascade ? r.n - 2 : 1;  // rows [1, down_end) have a downward spring
+  int i = 1;
+  for (; i < down_end; ++i) integrate_row<kModel, kWindy, false, kCascade>(r, i, in, m);
+  for (; i < r.n; ++i) integrate_row<kModel, kWindy, false, false>(r, i, in, m);
 }
 
 // Edge length constraints (edge_length): odd edges, then even ones, mass-weighted.
@@ -135,11 +237,30 @@ void edge_length(const Rows& r) {
     }
 }
 
-// Sphere collisions (collide_spheres). A vector test finds the lanes of a row inside
-// any sphere; a vertex outside every sphere is not moved by any pass. The few inside
-// take the per-strand kernel's passes one lane at a time: a push (a root and three
-// divisions) for sixteen lanes costs more than the scalar pushes of the lanes that need
-// one.
+// Whether any of a row's W int flags (0 or 1) is set: the flags as bytes, read back in
+// 8-byte words (an OR reduction over int lanes compiles to one extract per lane).
+inline bool any_lane(const int* flags) {
+  alignas(64) std::uint8_t bytes[W];
+  LANES { bytes[l] = static_cast<std::uint8_t>(flags[l]); }
+  std::uint64_t any = 0;
+  for (int w = 0; w < W; w += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, bytes + w, sizeof word);
+    any |= word;
+  }
+  return any != 0;
+}
+
+// Sphere collisions (collide_spheres). A vector test finds the rows with a free lane
+// inside any sphere (about one in five on the model-1 ponytail); a vertex outside every
+// sphere is not moved by any pass, so only those rows take the per-strand kernel's
+// passes, all lanes at once with the lanes outside masked off. A lane whose pass moved
+// nothing would move no more in later passes (the same position meets the same tests), so
+// the row stops when no lane moved, as each strand's loop does. Vector pushes beat one
+// scalar push per lane inside: the cascade's strands rest on the spheres with several
+// lanes of a row inside (measured 8% of its frame on model 1, the spring model even).
+// The test accumulates into every lane with bitwise operations (no branch, no reduction
+// per sphere), so it stays one vector loop per sphere.
 void collide(const Rows& r, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < r.n; ++i) {
@@ -147,59 +268,42 @@ void collide(const Rows& r, const Substep& s) {
     const int o = i * W;
     const float* iw = r.field(IW, i);
     float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
-    alignas(64) int hit[W] = {};
-    int any = 0;
+    alignas(64) int hit[W];
+    LANES { hit[l] = 0; }
     for (int c = 0; c < s.sphere_count; ++c) {
       const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
                   rad = s.spheres[4 * c + 3];
+      const float rad2 = rad * rad;
       LANES {
         const float dx = px[l] - sx, dy = py[l] - sy, dz = pz[l] - sz;
         const float dist2 = dx * dx + (dy * dy + dz * dz);
-        const int in = iw[l] != 0.0f && !(dist2 >= rad * rad);
-        hit[l] |= in;
-        any |= in;
+        hit[l] |= static_cast<int>(!(dist2 >= rad2));
       }
     }
-    if (!any) continue;
-    for (int l = 0; l < W; ++l) {
-      if (!hit[l]) continue;
-      float x = px[l], y = py[l], z = pz[l];
-      for (int pass = 0; pass < kPasses; ++pass) {
-        bool moved = false;
-        for (int c = 0; c < s.sphere_count; ++c) {
-          const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
-                      rad = s.spheres[4 * c + 3];
+    LANES { hit[l] &= static_cast<int>(iw[l] != 0.0f); }
+    if (!any_lane(hit)) continue;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      alignas(64) int moved[W];
+      LANES { moved[l] = 0; }
+      for (int c = 0; c < s.sphere_count; ++c) {
+        const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
+                    rad = s.spheres[4 * c + 3];
+        const float rad2 = rad * rad;
+        LANES {
+          const float x = px[l], y = py[l], z = pz[l];
           const float dx = x - sx, dy = y - sy, dz = z - sz;
           const float dist2 = dx * dx + (dy * dy + dz * dz);
-          if (dist2 >= rad * rad) continue;
+          const bool inside = (hit[l] != 0) & !(dist2 >= rad2);
           const float dist = std::sqrt(dist2);
           // A vertex exactly at the centre has no closest point; push it straight up.
           const bool off = dist > 0.0f;
-          x = sx + (off ? dx / dist : 0.0f) * rad;
-          y = sy + (off ? dy / dist : 1.0f) * rad;
-          z = sz + (off ? dz / dist : 0.0f) * rad;
-          moved = true;
+          px[l] = inside ? sx + (off ? dx / dist : 0.0f) * rad : x;
+          py[l] = inside ? sy + (off ? dy / dist : 1.0f) * rad : y;
+          pz[l] = inside ? sz + (off ? dz / dist : 0.0f) * rad : z;
+          moved[l] |= static_cast<int>(inside);
         }
-        if (!moved) break;
       }
-      px[l] = x;
-      py[l] = y;
-      pz[l] = z;
-    }
-  }
-}
-
-// §4.4: reference nodes rigid with the head, lifted against gravity (head_references).
-void spring_references(const Rows& r, const soa::AffinePose& h, const Frame& f) {
-  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
-  for (int i = 0; i < r.n; ++i) {
-    const int o = i * W;
-    const float *rx = r.field(RX, i), *ry = r.field(RY, i), *rz = r.field(RZ, i), *lift = r.field(LIFT, i);
-    float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
-    LANES {
-      ux[l] = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];
-      uy[l] = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
-      uz[l] = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
+      if (!any_lane(moved)) break;
     }
   }
 }
@@ -229,12 +333,13 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
   const int n = r.n;
   const float* rest_space = r.c + static_cast<std::size_t>(kCascadeFields) * n * W;
   // The root segment's space, rigid with the head: head rotation · rest space.
-  Space parent;
+  // sp[0] the root's; then row i's parent is sp[i & 1] and its space goes to the other.
+  Space sp[2];
   for (int col = 0; col < 3; ++col)
     for (int row = 0; row < 3; ++row) {
       const float h0 = s.m[3 * row], h1 = s.m[3 * row + 1], h2 = s.m[3 * row + 2];
       const float *s0 = rest_space + (3 * col) * W, *s1 = s0 + W, *s2 = s1 + W;
-      float* out = parent.v[3 * col + row];
+      float* out = sp[0].v[3 * col + row];
       LANES { out[l] = h0 * s0[l] + (h1 * s1[l] + h2 * s2[l]); }
     }
   // Rows 0 and 1 have no upward reference node; their springs have k = 0 and pull
@@ -255,12 +360,17 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
     place(m, r.field(DX, i), r.field(DY, i), r.field(DZ, i), r.px + p, r.py + p, r.pz + p, r.field(LIFT, i), f,
           r.dx + o, r.dy + o, r.dz + o);
   };
-  if (n > 2) up(parent, 2);
-  Space cur;
+  if (n > 2) up(sp[0], 2);
   for (int i = 2; i < n; ++i) {
+    const Space& parent = sp[i & 1];
+    Space& cur = sp[(i + 1) & 1];
     const int o = i * W;
     const float *ax = r.px + o - W, *ay = r.py + o - W, *az = r.pz + o - W;
     const float *bx = r.px + o, *by = r.py + o, *bz = r.pz + o;
+    // B = N × T_{n-1} normalised; where N is (nearly) parallel to the parent's T, B_{n-1}
+    // made perpendicular to N instead. That case is rare: it is computed, for the lanes
+    // in it, only in rows that have one (two roots and three divisions saved per row).
+    alignas(64) int narrow[W];
     LANES {
       const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
       const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
@@ -269,19 +379,13 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
       const float Tx = parent.v[6][l], Ty = parent.v[7][l], Tz = parent.v[8][l];
       float b0 = ny * Tz - nz * Ty, b1 = nz * Tx - nx * Tz, b2 = nx * Ty - ny * Tx;
       const float bl = std::sqrt(b0 * b0 + (b1 * b1 + b2 * b2));
-      // N parallel to the parent's T: B_{n-1} made perpendicular to N.
-      const float Bx = parent.v[0][l], By = parent.v[1][l], Bz = parent.v[2][l];
-      const float dot = Bx * nx + (By * ny + Bz * nz);
-      const float vx = Bx - dot * nx, vy = By - dot * ny, vz = Bz - dot * nz;
-      const float vn2 = vx * vx + (vy * vy + vz * vz);
-      const float vn = std::sqrt(vn2);
-      const bool wide = bl > 1e-6f;
-      b0 = wide ? b0 / bl : vn2 > 0.0f ? vx / vn : vx;
-      b1 = wide ? b1 / bl : vn2 > 0.0f ? vy / vn : vy;
-      b2 = wide ? b2 / bl : vn2 > 0.0f ? vz / vn : vz;
-      cur.v[0][l] = ok ? b0 : Bx;
-      cur.v[1][l] = ok ? b1 : By;
-      cur.v[2][l] = ok ? b2 : Bz;
+      b0 = b0 / bl;
+      b1 = b1 / bl;
+      b2 = b2 / bl;
+      narrow[l] = static_cast<int>(ok) & static_cast<int>(!(bl > 1e-6f));
+      cur.v[0][l] = ok ? b0 : parent.v[0][l];
+      cur.v[1][l] = ok ? b1 : parent.v[1][l];
+      cur.v[2][l] = ok ? b2 : parent.v[2][l];
       cur.v[3][l] = ok ? nx : parent.v[3][l];
       cur.v[4][l] = ok ? ny : parent.v[4][l];
       cur.v[5][l] = ok ? nz : parent.v[5][l];
@@ -289,11 +393,71 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
       cur.v[7][l] = ok ? nz * b0 - nx * b2 : Ty;
       cur.v[8][l] = ok ? nx * b1 - ny * b0 : Tz;
     }
+    if (any_lane(narrow))
+      LANES {
+        const bool on = narrow[l] != 0;
+        const float nx = cur.v[3][l], ny = cur.v[4][l], nz = cur.v[5][l];
+        const float Bx = parent.v[0][l], By = parent.v[1][l], Bz = parent.v[2][l];
+        const float dot = Bx * nx + (By * ny + Bz * nz);
+        const float vx = Bx - dot * nx, vy = By - dot * ny, vz = Bz - dot * nz;
+        const float vn2 = vx * vx + (vy * vy + vz * vz);
+        const float vn = std::sqrt(vn2);
+        const float b0 = vn2 > 0.0f ? vx / vn : vx, b1 = vn2 > 0.0f ? vy / vn : vy, b2 = vn2 > 0.0f ? vz / vn : vz;
+        cur.v[0][l] = on ? b0 : cur.v[0][l];
+        cur.v[1][l] = on ? b1 : cur.v[1][l];
+        cur.v[2][l] = on ? b2 : cur.v[2][l];
+        cur.v[6][l] = on ? ny * b2 - nz * b1 : cur.v[6][l];
+        cur.v[7][l] = on ? nz * b0 - nx * b2 : cur.v[7][l];
+        cur.v[8][l] = on ? nx * b1 - ny * b0 : cur.v[8][l];
+      }
     if (i + 1 < n) up(cur, i + 1);
     down(cur, i - 2);
-    parent = cur;
   }
 }
+
+// The block's positions to the groom-ordered float4 array, for the lanes asked for. With
+// AVX-512 a row's x, y, z and inverse mass (the groom's w, unchanged) are transposed into
+// one float4 per lane, sixteen 16-byte stores instead of 48 scalar loads and stores.
+// (GCC 12 warns that the unpack intrinsics' internal undefined operand may be
+// uninitialised; it is a false positive.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+void write_back(const Rows& r, const Block& b, float* out) {
+#if defined(__AVX512F__)
+  static_assert(W == 16, "the AVX-512 transpose takes 16 lanes");
+  float* base[W];
+  for (int l = 0; l < W; ++l) base[l] = b.write[l] ? out + 4 * static_cast<std::size_t>(b.offset[l]) : nullptr;
+  for (int i = 0; i < r.n; ++i) {
+    const __m512 x = _mm512_loadu_ps(r.px + i * W), y = _mm512_loadu_ps(r.py + i * W),
+                 z = _mm512_loadu_ps(r.pz + i * W), w = _mm512_loadu_ps(r.field(IW, i));
+    const __m512 t0 = _mm512_unpacklo_ps(x, y), t1 = _mm512_unpackhi_ps(x, y);
+    const __m512 t2 = _mm512_unpacklo_ps(z, w), t3 = _mm512_unpackhi_ps(z, w);
+    // v[m] holds lane 4k + m's float4 in its 128-bit part k.
+    const __m512 v[4] = {_mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)),
+                         _mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
+                         _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)),
+                         _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2))};
+    const std::size_t o = 4 * static_cast<std::size_t>(i);
+    for (int m = 0; m < 4; ++m) {
+      if (base[m]) _mm_storeu_ps(base[m] + o, _mm512_extractf32x4_ps(v[m], 0));
+      if (base[4 + m]) _mm_storeu_ps(base[4 + m] + o, _mm512_extractf32x4_ps(v[m], 1));
+      if (base[8 + m]) _mm_storeu_ps(base[8 + m] + o, _mm512_extractf32x4_ps(v[m], 2));
+      if (base[12 + m]) _mm_storeu_ps(base[12 + m] + o, _mm512_extractf32x4_ps(v[m], 3));
+    }
+  }
+#else
+  for (int l = 0; l < W; ++l) {
+    if (!b.write[l]) continue;
+    float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
+    for (int i = 0; i < r.n; ++i) {
+      o[4 * i] = r.px[i * W + l];
+      o[4 * i + 1] = r.py[i * W + l];
+      o[4 * i + 2] = r.pz[i * W + l];
+    }
+  }
+#endif
+}
+#pragma GCC diagnostic pop
 
 template <Model kModel>
 void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
@@ -319,25 +483,17 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
     const soa::AffinePose h(s.m, s.t);
-    if constexpr (kModel == Model::Spring) {
-      spring_references(r, h, f);
-      clock.lap(kReferences);
-      follow_head(r, h);
-    } else {
+    if constexpr (kModel == Model::Cascade) {
       follow_head(r, h);
       cascade_references(r, s, f);
-      clock.lap(kReferences);
+      clock.lap(kReferences);  // the spring model's references are computed in its integration
     }
+    const Integration in{h,      f.gravity[0], f.gravity[1], f.gravity[2], f.wind[0], f.wind[1], f.wind[2],
+                         p.keep, s.dt2,        kModel == Model::Spring ? p.spring_scale[k] : 1.0f};
     if (f.windy)
-      verlet<true>(r, f, p.keep, s.dt2);
+      integrate<kModel, true>(r, in);
     else
-      verlet<false>(r, f, p.keep, s.dt2);
-    if constexpr (kModel == Model::Spring) {
-      springs(r, KU, r.ux, r.uy, r.uz, n, p.spring_scale[k], s.dt2);
-    } else {
-      springs(r, KU, r.ux, r.uy, r.uz, n, 1.0f, s.dt2);
-      springs(r, KD, r.dx, r.dy, r.dz, n - 2, 1.0f, s.dt2);
-    }
+      integrate<kModel, false>(r, in);
     clock.lap(kIntegrate);
     for (int it = 0; it < p.length_iterations; ++it) edge_length(r);
     clock.lap(kLength);
@@ -346,15 +502,7 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
       clock.lap(kCollision);
     }
   }
-  for (int l = 0; l < W; ++l) {
-    if (!b.write[l]) continue;
-    float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
-    for (int i = 0; i < n; ++i) {
-      o[4 * i] = r.px[i * W + l];
-      o[4 * i + 1] = r.py[i * W + l];
-      o[4 * i + 2] = r.pz[i * W + l];
-    }
-  }
+  write_back(r, b, out);
   clock.lap(kIntegrate);
 }
 
