@@ -3,6 +3,7 @@
 // halen_soa_kernel.cpp.
 #include "kernels/cpu/halen_soa.h"
 #include "kernels/cpu/soa_common.h"
+#include "kernels/cpu/soa_write_back.h"
 #include "kernels/cpu/vec_math.h"
 
 #include <cmath>
@@ -209,36 +210,34 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
 }
 
 void forest_frame(const Block& b, const ForestParams& p, const ForestFrame& f, float* out, float* scratch,
-                  std::int64_t* stage_ns) {
+                  soa::LineFeed& feed, std::int64_t* stage_ns) {
   const int n = b.n;
   const std::size_t rows = static_cast<std::size_t>(n) * W;
   Rows r{n,          b.data,           b.state,          scratch,          scratch + 9 * rows,
          scratch + 10 * rows, scratch + 11 * rows, scratch + 12 * rows, scratch + 13 * rows, scratch + 14 * rows,
          b.rows};
   soa::StageClock clock(stage_ns);
+  feed.pace(2 * f.substep_count);  // each pose and integration requests a share of the next block
   for (int k = 0; k < f.substep_count; ++k) {
     if (f.parent_x)
       pose<true>(r, f.substeps[k]);
     else
       pose<false>(r, f.substeps[k]);
     clock.lap(kPose);
+    feed.step();
     integrate(r, f.substeps[k], f, p);
     clock.lap(kForestIntegrate);
+    feed.step();
   }
   if (f.parent_x)
     pose<true>(r, f.substeps[f.substep_count]);
   else
     pose<false>(r, f.substeps[f.substep_count]);
-  for (int l = 0; l < W; ++l) {
-    if (!b.write[l]) continue;
-    float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
-    for (int i = 0; i < n; ++i) {
-      o[4 * i] = r.px[i * W + l];
-      o[4 * i + 1] = r.py[i * W + l];
-      o[4 * i + 2] = r.pz[i * W + l];
-    }
-  }
+  float* lane_out[W];
+  for (int l = 0; l < W; ++l) lane_out[l] = b.write[l] ? out + 4 * static_cast<std::size_t>(b.offset[l]) : nullptr;
+  soa::write_rows_float4(r.px, r.py, r.pz, r.field(FIW, 0), n, lane_out);  // w: the groom's, unchanged
   clock.lap(kPose);
+  feed.finish();
 }
 
 }  // namespace

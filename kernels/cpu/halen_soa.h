@@ -131,7 +131,7 @@ struct ForestParams {
   float collision_stiffness;
 };
 using ForestFrameFn = void (*)(const Block& block, const ForestParams& params, const ForestFrame& frame, float* out,
-                               float* scratch, std::int64_t* stage_ns);
+                               float* scratch, soa::LineFeed& feed, std::int64_t* stage_ns);
 ForestFrameFn forest_kernel();
 ForestFrameFn forest_kernel_baseline();
 // Stages of the forest kernel's stage_ns.
@@ -139,10 +139,11 @@ enum ForestStage : int { kPose, kForestIntegrate, kForestStageCount };
 
 // Advances every lane of one block by one frame and writes the xyz of the lanes with
 // write[l] set to `out` (float4 per vertex, groom order). scratch holds scratch_floats(n)
-// floats. With stage_ns non-null, adds the nanoseconds spent in each Stage (callers pass
-// it for a sample of blocks only).
+// floats. feed holds the next block's memory, requested stage by stage (soa::LineFeed).
+// With stage_ns non-null, adds the nanoseconds spent in each Stage (callers pass it for a
+// sample of blocks only).
 using FrameFn = void (*)(Model model, const Block& block, const BlockParams& params, const Frame& frame, float* out,
-                         float* scratch, std::int64_t* stage_ns);
+                         float* scratch, soa::LineFeed& feed, std::int64_t* stage_ns);
 
 // The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline
 // build. Both give the same bits (the forest's too: its polynomial is the same code).

@@ -4,14 +4,11 @@
 // instructions of that variant.
 #include "kernels/cpu/halen_soa.h"
 #include "kernels/cpu/soa_common.h"
+#include "kernels/cpu/soa_write_back.h"
 
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
 
 #ifndef HALEN_SOA_VARIANT
 #error "HALEN_SOA_VARIANT must name the ISA variant"
@@ -37,8 +34,9 @@ struct Rows {
 };
 
 // Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest; the
-// cascade's, before its references read the moved roots. The pose is taken by value: through a reference the compiler must assume the row stores may
-// change it, and leaves the lane loop scalar.
+// cascade's, before its references read the moved roots. The pose is taken by value:
+// through a reference the compiler must assume the row stores may change it, and leaves
+// the lane loop scalar.
 void follow_head(const Rows& r, const soa::AffinePose h) {
   for (int i = 0; i < r.n; ++i) {
     if (r.kind[i] == kRowFree) continue;
@@ -415,52 +413,16 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
   }
 }
 
-// The block's positions to the groom-ordered float4 array, for the lanes asked for. With
-// AVX-512 a row's x, y, z and inverse mass (the groom's w, unchanged) are transposed into
-// one float4 per lane, sixteen 16-byte stores instead of 48 scalar loads and stores.
-// (GCC 12 warns that the unpack intrinsics' internal undefined operand may be
-// uninitialised; it is a false positive.)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// The block's positions to the groom-ordered float4 array, for the lanes asked for (w:
+// the inverse mass, the groom's w unchanged).
 void write_back(const Rows& r, const Block& b, float* out) {
-#if defined(__AVX512F__)
-  static_assert(W == 16, "the AVX-512 transpose takes 16 lanes");
-  float* base[W];
-  for (int l = 0; l < W; ++l) base[l] = b.write[l] ? out + 4 * static_cast<std::size_t>(b.offset[l]) : nullptr;
-  for (int i = 0; i < r.n; ++i) {
-    const __m512 x = _mm512_loadu_ps(r.px + i * W), y = _mm512_loadu_ps(r.py + i * W),
-                 z = _mm512_loadu_ps(r.pz + i * W), w = _mm512_loadu_ps(r.field(IW, i));
-    const __m512 t0 = _mm512_unpacklo_ps(x, y), t1 = _mm512_unpackhi_ps(x, y);
-    const __m512 t2 = _mm512_unpacklo_ps(z, w), t3 = _mm512_unpackhi_ps(z, w);
-    // v[m] holds lane 4k + m's float4 in its 128-bit part k.
-    const __m512 v[4] = {_mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)),
-                         _mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
-                         _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)),
-                         _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2))};
-    const std::size_t o = 4 * static_cast<std::size_t>(i);
-    for (int m = 0; m < 4; ++m) {
-      if (base[m]) _mm_storeu_ps(base[m] + o, _mm512_extractf32x4_ps(v[m], 0));
-      if (base[4 + m]) _mm_storeu_ps(base[4 + m] + o, _mm512_extractf32x4_ps(v[m], 1));
-      if (base[8 + m]) _mm_storeu_ps(base[8 + m] + o, _mm512_extractf32x4_ps(v[m], 2));
-      if (base[12 + m]) _mm_storeu_ps(base[12 + m] + o, _mm512_extractf32x4_ps(v[m], 3));
-    }
-  }
-#else
-  for (int l = 0; l < W; ++l) {
-    if (!b.write[l]) continue;
-    float* o = out + static_cast<std::size_t>(b.offset[l]) * 4;
-    for (int i = 0; i < r.n; ++i) {
-      o[4 * i] = r.px[i * W + l];
-      o[4 * i + 1] = r.py[i * W + l];
-      o[4 * i + 2] = r.pz[i * W + l];
-    }
-  }
-#endif
+  float* lane_out[W];
+  for (int l = 0; l < W; ++l) lane_out[l] = b.write[l] ? out + 4 * static_cast<std::size_t>(b.offset[l]) : nullptr;
+  soa::write_rows_float4(r.px, r.py, r.pz, r.field(IW, 0), r.n, lane_out);
 }
-#pragma GCC diagnostic pop
 
 template <Model kModel>
-void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
+void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch, soa::LineFeed& feed,
                 std::int64_t* stage_ns) {
   const int n = b.n;
   const std::size_t rows = static_cast<std::size_t>(n) * W;
@@ -480,6 +442,9 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
          b.data,
          b.rows};
   soa::StageClock clock(stage_ns);
+  // Each finished stage (and length iteration) requests its share of the next block's lines.
+  feed.pace(f.substep_count * ((kModel == Model::Cascade) + 1 + p.length_iterations +
+                               (f.substep_count > 0 && f.substeps[0].sphere_count > 0)));
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
     const soa::AffinePose h(s.m, s.t);
@@ -487,6 +452,7 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
       follow_head(r, h);
       cascade_references(r, s, f);
       clock.lap(kReferences);  // the spring model's references are computed in its integration
+      feed.step();
     }
     const Integration in{h,      f.gravity[0], f.gravity[1], f.gravity[2], f.wind[0], f.wind[1], f.wind[2],
                          p.keep, s.dt2,        kModel == Model::Spring ? p.spring_scale[k] : 1.0f};
@@ -495,23 +461,29 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
     else
       integrate<kModel, false>(r, in);
     clock.lap(kIntegrate);
-    for (int it = 0; it < p.length_iterations; ++it) edge_length(r);
+    feed.step();
+    for (int it = 0; it < p.length_iterations; ++it) {
+      edge_length(r);
+      feed.step();
+    }
     clock.lap(kLength);
     if (s.sphere_count > 0) {
       collide(r, s);
       clock.lap(kCollision);
+      feed.step();
     }
   }
   write_back(r, b, out);
   clock.lap(kIntegrate);
+  feed.finish();
 }
 
 void frame(Model model, const Block& b, const BlockParams& p, const Frame& f, float* out, float* scratch,
-           std::int64_t* stage_ns) {
+           soa::LineFeed& feed, std::int64_t* stage_ns) {
   if (model == Model::Spring)
-    frame_impl<Model::Spring>(b, p, f, out, scratch, stage_ns);
+    frame_impl<Model::Spring>(b, p, f, out, scratch, feed, stage_ns);
   else
-    frame_impl<Model::Cascade>(b, p, f, out, scratch, stage_ns);
+    frame_impl<Model::Cascade>(b, p, f, out, scratch, feed, stage_ns);
 }
 
 }  // namespace

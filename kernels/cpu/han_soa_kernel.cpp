@@ -4,6 +4,7 @@
 // instructions of that variant.
 #include "kernels/cpu/han_soa.h"
 #include "kernels/cpu/soa_common.h"
+#include "kernels/cpu/soa_write_back.h"
 
 #include <cmath>
 #include <cstring>
@@ -485,54 +486,14 @@ void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
   }
 }
 
-// The block's positions to the groom-ordered float4 array: a transpose of each row's
-// x, y, z, w vectors into one float4 per lane. (GCC 12 warns that the unpack
-// intrinsics' internal undefined operand may be uninitialised; it is a false positive.)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// The block's positions to the groom-ordered float4 array (w: the inverse mass, as the
+// groom's).
 void write_back(const Rows& r, int n, const std::uint32_t* offset, float* out) {
-  bool full = true;
-  for (int l = 0; l < W; ++l) full = full && offset[l] != kNoStrand;
-#if defined(__AVX512F__)
-  static_assert(W == 16, "the AVX-512 transpose takes 16 lanes");
-  if (full) {
-    float* base[W];
-    for (int l = 0; l < W; ++l) base[l] = out + 4 * static_cast<std::size_t>(offset[l]);
-    for (int i = 0; i < n; ++i) {
-      const __m512 x = _mm512_load_ps(r.px + i * W), y = _mm512_load_ps(r.py + i * W),
-                   z = _mm512_load_ps(r.pz + i * W), w = _mm512_load_ps(r.iw + i * W);
-      const __m512 t0 = _mm512_unpacklo_ps(x, y), t1 = _mm512_unpackhi_ps(x, y);
-      const __m512 t2 = _mm512_unpacklo_ps(z, w), t3 = _mm512_unpackhi_ps(z, w);
-      // v_m holds lane 4k + m's float4 in its 128-bit part k.
-      const __m512 v[4] = {_mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)),
-                           _mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
-                           _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)),
-                           _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2))};
-      const std::size_t o = 4 * static_cast<std::size_t>(i);
-      for (int m = 0; m < 4; ++m) {
-        _mm_storeu_ps(base[m] + o, _mm512_extractf32x4_ps(v[m], 0));
-        _mm_storeu_ps(base[4 + m] + o, _mm512_extractf32x4_ps(v[m], 1));
-        _mm_storeu_ps(base[8 + m] + o, _mm512_extractf32x4_ps(v[m], 2));
-        _mm_storeu_ps(base[12 + m] + o, _mm512_extractf32x4_ps(v[m], 3));
-      }
-    }
-    return;
-  }
-#else
-  (void)full;
-#endif
-  for (int l = 0; l < W; ++l) {
-    if (offset[l] == kNoStrand) continue;
-    float* o = out + 4 * static_cast<std::size_t>(offset[l]);
-    for (int i = 0; i < n; ++i) {
-      o[4 * i] = r.px[i * W + l];
-      o[4 * i + 1] = r.py[i * W + l];
-      o[4 * i + 2] = r.pz[i * W + l];
-      o[4 * i + 3] = r.iw[i * W + l];
-    }
-  }
+  float* lane_out[W];
+  for (int l = 0; l < W; ++l)
+    lane_out[l] = offset[l] == kNoStrand ? nullptr : out + 4 * static_cast<std::size_t>(offset[l]);
+  soa::write_rows_float4(r.px, r.py, r.pz, r.iw, n, lane_out);
 }
-#pragma GCC diagnostic pop
 
 // What the stages need of one block.
 struct Ctx {

@@ -15,9 +15,6 @@ namespace k = hairbench::kernels;
 
 // One block in this many (and the first of every region) times its stages.
 constexpr std::size_t kSampleEvery = 16;
-// Blocks ahead whose data is prefetched: with few substeps a block computes in less time
-// than one block's memory takes to arrive.
-constexpr std::size_t kPrefetchAhead = 2;
 
 HalenFusedModel::HalenFusedModel(Model model, const ModelContext& ctx)
     : model_(model), ctx_(ctx), kernel_(soa::frame_kernel()), forest_kernel_(soa::forest_kernel()) {}
@@ -216,21 +213,14 @@ std::size_t HalenFusedModel::state_bytes() const {
   return (data_.size() + state_.size()) * sizeof(float) + pos_.size() * sizeof(Vec4f);
 }
 
-// Asks for the next block's fields, state and output lines while this block computes: a block's
-// strands are a few hundred bytes each, spread over the groom, too little for the
-// hardware prefetchers to ramp up.
-void HalenFusedModel::prefetch(const BlockInfo& b) const {
-  constexpr std::size_t kLine = 64;
-  const char* d = reinterpret_cast<const char*>(data_.data() + b.offset);
-  const std::size_t bytes = block_floats(b.n) * sizeof(float);
-  for (std::size_t o = 0; o < bytes; o += kLine) __builtin_prefetch(d + o, 0, 3);
-  const char* st = reinterpret_cast<const char*>(state_.data() + b.state);
-  for (std::size_t o = 0; o < state_floats(b.n) * sizeof(float); o += kLine) __builtin_prefetch(st + o, 1, 3);
-  for (int l = 0; l < W; ++l) {
-    if (b.strand[l] == kNoStrand) continue;
-    const char* p = reinterpret_cast<const char*>(pos_.data() + b.offset_of[l]);
-    for (std::size_t o = 0; o < b.n * sizeof(Vec4f); o += kLine) __builtin_prefetch(p + o, 1, 3);
-  }
+// The next block's fields, state and output lines, for the kernel to request while this
+// block computes (soa::LineFeed).
+void HalenFusedModel::feed_block(const BlockInfo& b, k::soa::LineFeed& feed) const {
+  feed.clear();
+  feed.add(data_.data() + b.offset, block_floats(b.n) * sizeof(float));
+  feed.add(state_.data() + b.state, state_floats(b.n) * sizeof(float));
+  for (int l = 0; l < W; ++l)
+    if (b.strand[l] != kNoStrand) feed.add(pos_.data() + b.offset_of[l], b.n * sizeof(Vec4f));
 }
 
 void HalenFusedModel::run_thread(int t) {
@@ -238,6 +228,7 @@ void HalenFusedModel::run_thread(int t) {
   float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
   float* backup = backup_.data() + backup_stride_ * static_cast<std::size_t>(t);
   float* out = pos_.data()->data();
+  k::soa::LineFeed feed;
   for (std::size_t i = ts.first; i < ts.last; ++i) {
     const BlockInfo& b = blocks_[i];
     std::uint8_t* write = write_.data() + i * W;
@@ -250,9 +241,10 @@ void HalenFusedModel::run_thread(int t) {
       asleep += sleeps;
     }
     if (awake == 0) continue;  // every strand of the block sleeps
-    if (i == ts.first)
-      for (std::size_t k = 1; k < kPrefetchAhead && i + k < ts.last; ++k) prefetch(blocks_[i + k]);
-    if (i + kPrefetchAhead < ts.last) prefetch(blocks_[i + kPrefetchAhead]);
+    if (i + 1 < ts.last)
+      feed_block(blocks_[i + 1], feed);
+    else
+      feed.clear();
     float* state = state_.data() + b.state;
     const std::size_t floats = state_floats(b.n);
     if (asleep > 0) std::copy_n(state, floats, backup);
@@ -263,9 +255,9 @@ void HalenFusedModel::run_thread(int t) {
     std::int64_t* stage_ns = b.sampled ? ts.stage_ns.data() : nullptr;
     const auto start = std::chrono::steady_clock::now();
     if (model_ == Model::Forest)
-      forest_kernel_(block, r.forest, forest_frame_, out, scratch, stage_ns);
+      forest_kernel_(block, r.forest, forest_frame_, out, scratch, feed, stage_ns);
     else
-      kernel_(model_, block, p, frame_, out, scratch, stage_ns);
+      kernel_(model_, block, p, frame_, out, scratch, feed, stage_ns);
     if (b.sampled)
       ts.sampled_ns +=
           std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();

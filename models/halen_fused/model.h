@@ -58,7 +58,7 @@ class HalenFusedModel final : public HairModel {
   std::size_t state_floats(int n) const;
   void setup_blocks(const Groom& rest, const ParamSet& params);
   void forest_substeps(const FrameInput& in, float dt);
-  void prefetch(const BlockInfo& b) const;
+  void feed_block(const BlockInfo& b, kernels::soa::LineFeed& feed) const;
   void run_thread(int t);
   void observe_sleep(int t, float dt);
 
