@@ -49,7 +49,7 @@ struct WispSystem {
   std::vector<std::uint16_t> wisp_params;  // index into the params table, per wisp
 
   // Skeleton (§3.2). Pinned nodes (the first segment, inside the head) follow the head.
-  std::vector<Vec3f> x, v, acc;   // acc: the force-driven acceleration of the last step
+  std::vector<Vec3f> x, v, acc;   // acc: scratch of wisp_forces_and_velocities (the block kernel keeps its own)
   std::vector<Vec3f> rest_x;      // head rest frame
   std::vector<std::uint8_t> pinned;
   std::vector<float> rest_len;    // segment (k-1, k), stored at k (0 at a wisp's first node)

@@ -217,6 +217,21 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   const float r_min = static_cast<float>(params.get("wisp_radius_min"));
   for (float& r : sys_.r_rest) r = std::max(r, r_min);
   for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
+  // Blocks of the fused schedule: consecutive wisps of one node count and params set
+  // (k-means clusters of one region and strand size are consecutive, cluster()).
+  runs_.clear();
+  constexpr std::uint32_t lanes = k::wisp_soa::kLanes;
+  const auto wisps = static_cast<std::uint32_t>(sys_.wisp_count());
+  auto size = [&](std::uint32_t w) { return sys_.node_begin[w + 1] - sys_.node_begin[w]; };
+  for (std::uint32_t w = 0; w < wisps;) {
+    std::uint32_t n = 0;
+    while (n < lanes && w + n < wisps && k::wisp_soa::block_eligible(sys_, w + n) && size(w + n) == size(w) &&
+           sys_.wisp_params[w + n] == sys_.wisp_params[w])
+      ++n;
+    if (n < lanes) n = 1;
+    runs_.push_back({w, n});
+    w += n;
+  }
 
   const int chunks = ctx_.pool ? ctx_.pool->threads() : 1;
   chunk_contacts_.assign(static_cast<std::size_t>(chunks), {});
@@ -241,27 +256,26 @@ void PlanteWispModel::WispClock::lap(int stage) {
 }
 
 template <class F>
-void PlanteWispModel::for_each_wisp(F&& f) {
+void PlanteWispModel::for_each(std::size_t count, F&& f) {
   // Static partition (ThreadPool::parallel_for): each wisp's result does not depend on
   // which thread runs it.
-  const std::size_t n = sys_.wisp_count();
-  if (ctx_.pool && n >= static_cast<std::size_t>(threads_min_wisps_))
-    ctx_.pool->parallel_for(n, [&](std::size_t begin, std::size_t end) { f(begin, end); });
+  if (ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
+    ctx_.pool->parallel_for(count, [&](std::size_t begin, std::size_t end) { f(begin, end); });
   else
-    f(std::size_t{0}, n);
+    f(std::size_t{0}, count);
 }
 
 template <class F>
 void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
   for (auto& ns : sampled_ns_) ns.store(0, std::memory_order_relaxed);
   const auto start = std::chrono::steady_clock::now();
-  for_each_wisp([&](std::size_t begin, std::size_t end) {
+  for_each(runs_.size(), [&](std::size_t begin, std::size_t end) {
     WispClock clock;
     clock.sampled_ns = {&sampled_ns_[0], &sampled_ns_[1]};
-    for (std::size_t w = begin; w < end; ++w) {
-      clock.on = w % kTimingSample == 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      clock.on = i % kTimingSample == 0;
       if (clock.on) clock.last = std::chrono::steady_clock::now();
-      f(w, clock);
+      f(runs_[i], clock);
     }
   });
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -275,7 +289,7 @@ void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
 template <class F>
 void PlanteWispModel::stage_pass(StageTimes& times, std::string_view stage, F&& f) {
   StageTimer t(times, stage);
-  for_each_wisp([&](std::size_t begin, std::size_t end) {
+  for_each(sys_.wisp_count(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t w = begin; w < end; ++w) f(w);
   });
 }
@@ -369,22 +383,38 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // them in one pass while it is in cache; the wisp-wisp response, which reads every
     // wisp, splits the pass in two on the steps that detect. Same operations in the same
     // order per wisp as the per-stage schedule (plante_wisp_ref): bit-identical.
-    auto velocities = [&](std::size_t w, WispClock& clock) {
-      k::wisp_pin(sys_, w, head, h);
-      k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head_rot, in.gravity, in.wind, h);
+    auto velocities = [&](const WispRun& run, WispClock& clock) {
+      const k::WispParams& p = params_[sys_.wisp_params[run.first]];
+      for (std::uint32_t w = run.first; w < run.first + run.count; ++w) k::wisp_pin(sys_, w, head, h);
+      if (run.count == 1) {
+        k::wisp_forces_and_velocities(sys_, run.first, p, head_rot, in.gravity, in.wind, h);
+      } else {
+        std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
+        for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
+        block_.velocities(sys_, ids.data(), p, head_rot, in.gravity, in.wind, h);
+      }
       clock.lap(kIntegration);
       if (body_on) {
-        k::wisp_body_slide(sys_, w, body, drag);
+        for (std::uint32_t w = run.first; w < run.first + run.count; ++w) k::wisp_body_slide(sys_, w, body, drag);
         clock.lap(kBody);
       }
     };
-    auto positions = [&](std::size_t w, WispClock& clock) {
-      const Vec3f root_e1 = head_rot * sys_.rest_e1[w];
-      k::wisp_positions(sys_, w, root_e1, h);
+    auto positions = [&](const WispRun& run, WispClock& clock) {
+      std::array<Vec3f, k::wisp_soa::kLanes> root_e1;
+      for (std::uint32_t l = 0; l < run.count; ++l) root_e1[l] = head_rot * sys_.rest_e1[run.first + l];
+      if (run.count == 1) {
+        k::wisp_positions(sys_, run.first, root_e1[0], h);
+      } else {
+        std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
+        for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
+        block_.positions(sys_, ids.data(), root_e1.data(), h);
+      }
       clock.lap(kIntegration);
       if (body_on) {
-        k::wisp_body_hold(sys_, w, body);
-        if (body_due) k::wisp_body_detect(sys_, w, body, root_e1, interaction_.contact_threshold);
+        for (std::uint32_t l = 0; l < run.count; ++l) {
+          k::wisp_body_hold(sys_, run.first + l, body);
+          if (body_due) k::wisp_body_detect(sys_, run.first + l, body, root_e1[l], interaction_.contact_threshold);
+        }
         clock.lap(kBody);
       }
     };
@@ -425,9 +455,9 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       }
       wisp_pass(times, positions);
     } else {
-      wisp_pass(times, [&](std::size_t w, WispClock& clock) {
-        velocities(w, clock);
-        positions(w, clock);
+      wisp_pass(times, [&](const WispRun& run, WispClock& clock) {
+        velocities(run, clock);
+        positions(run, clock);
       });
     }
     head_before = head;

@@ -10,6 +10,7 @@
 #include "core/sleep.h"
 #include "kernels/cpu/wisp_grid.h"
 #include "kernels/cpu/wisp_kernels.h"
+#include "kernels/cpu/wisp_soa.h"
 
 #include <array>
 #include <atomic>
@@ -60,10 +61,11 @@ class PlanteWispModel final : public HairModel {
     std::array<std::atomic<std::int64_t>*, 2> sampled_ns{};
     void lap(int stage);  // time since the last lap to `stage`, on sampled wisps
   };
-  // f(begin, end) over the wisps, split statically over the threads.
+  // f(begin, end) over [0, count), split statically over the threads.
   template <class F>
-  void for_each_wisp(F&& f);
-  // f(w, clock) for every wisp, over the threads; adds the pass's time to the stages.
+  void for_each(std::size_t count, F&& f);
+  // f(run, clock) for every run of wisps (runs_), over the threads; adds the pass's
+  // time to the stages.
   template <class F>
   void wisp_pass(StageTimes& times, F&& f);
   // f(w) for every wisp, over the threads, timed as `stage` (the per-stage schedule).
@@ -83,6 +85,14 @@ class PlanteWispModel final : public HairModel {
   StrandSleep sleep_;
 
   kernels::WispSystem sys_;
+  // The fused schedule's units of work, in wisp order: blocks of wisp_soa::kLanes
+  // consecutive wisps that the block kernels take together (one node count and one
+  // params set each), and single wisps.
+  struct WispRun {
+    std::uint32_t first, count;
+  };
+  std::vector<WispRun> runs_;
+  kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();
   std::vector<std::uint32_t> strand_wisp_;
   std::vector<Vec4f> coord_;  // per groom vertex
   std::vector<Vec4f> pos_;

@@ -1,0 +1,39 @@
+// The integration of Plante et al. 2001 (§5.1 steps 1, 3 and 4: forces, velocities,
+// positions and section frames) for a block of kLanes wisps at once, one wisp per lane
+// (issue 10). Every lane performs the floating-point operations of the per-wisp kernels
+// (wisp_kernels.h) in their order, so a wisp gets the same bits either way; the per-wisp
+// kernels stay the reference (plante_wisp_ref) and take over for any wisp of a block that
+// meets one of their rare branches (a zero-length segment, a frame fallback axis, a
+// half-turn minimal rotation). Compiled once per ISA variant and chosen at run time,
+// like the Han and Halén block kernels (kernels/CMakeLists.txt).
+#pragma once
+
+#include "kernels/cpu/wisp_kernels.h"
+
+namespace hairbench::kernels::wisp_soa {
+
+inline constexpr int kLanes = 16;
+// Longest wisp (in nodes) a block takes; longer ones go through the per-wisp kernels.
+inline constexpr int kMaxNodes = 32;
+
+// Whether wisp w can be a lane of a block: between 3 and kMaxNodes nodes, and not pinned
+// at its tip (the tip's bending spring to the head stays with wisp_forces_and_velocities).
+bool block_eligible(const WispSystem& s, std::size_t w);
+
+// The kLanes wisps `wisps` (each block_eligible, all of one node count and one params
+// set): wisp_forces_and_velocities for each (after wisp_pin).
+using VelocitiesFn = void (*)(WispSystem& s, const std::uint32_t* wisps, const WispParams& p,
+                              const Eigen::Matrix3f& head_rot, const Vec3f& gravity, const Wind& wind, float h);
+// wisp_positions for each, root_e1[l] the head-attached first axis of wisps[l].
+using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, float h);
+
+struct Kernels {
+  VelocitiesFn velocities;
+  PositionsFn positions;
+};
+
+// The variant for this CPU.
+Kernels kernels();
+const char* kernels_isa();
+
+}  // namespace hairbench::kernels::wisp_soa

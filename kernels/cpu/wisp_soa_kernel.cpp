@@ -1,0 +1,336 @@
+// The wisp block kernels of wisp_soa.h. This file is compiled once per ISA variant
+// (kernels/CMakeLists.txt), each time with PLANTE_SOA_VARIANT naming the namespace; the
+// loops over lanes are written plainly so the compiler turns each into vector
+// instructions of that variant. Each lane repeats the operations of the per-wisp kernel
+// (wisp_kernels.cpp) in Eigen's evaluation order for 3-vectors: a dot product or squared
+// norm is x + (y + z) (Eigen's unrolled reduction halves the terms), a vector over a
+// scalar divides each component, sums of vector terms go left to right.
+#include "kernels/cpu/wisp_soa.h"
+
+#include <cmath>
+
+#ifndef PLANTE_SOA_VARIANT
+#error "PLANTE_SOA_VARIANT must name the ISA variant"
+#endif
+
+namespace hairbench::kernels::wisp_soa::PLANTE_SOA_VARIANT {
+
+namespace {
+
+constexpr int W = kLanes;
+constexpr int N = kMaxNodes;
+constexpr int Q = kEnvelopePerSection;
+
+#define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
+#define EACH_Q _Pragma("GCC unroll 4") for (int q = 0; q < Q; ++q)
+
+struct F3 {
+  float x, y, z;
+};
+inline F3 sub(F3 a, F3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline F3 add(F3 a, F3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline F3 mul(float s, F3 a) { return {s * a.x, s * a.y, s * a.z}; }
+inline F3 quot(F3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
+inline float dot(F3 a, F3 b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
+inline F3 cross(F3 a, F3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline F3 pick(bool c, F3 a, F3 b) { return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z}; }
+
+// unit_or of wisp_kernels.cpp; `bad` is set where the fallback would be taken (set
+// without a branch, so that the lane loops stay vector code).
+inline F3 unit(F3 v, int& bad) {
+  const float n2 = dot(v, v);
+  bad |= !(n2 > 1e-24f);
+  return quot(v, std::sqrt(n2));
+}
+// minimal_rotate of wisp_kernels.cpp; `bad` is set on a half turn.
+inline F3 minimal_rotate(F3 a, F3 b, F3 v, int& bad) {
+  const float c = dot(a, b);
+  bad |= 1.0f + c < 1e-6f;
+  const F3 k = cross(a, b);
+  return add(add(mul(c, v), cross(k, v)), mul(dot(k, v) / (1.0f + c), k));
+}
+
+// Per node, the lanes' values of a vector quantity.
+struct V3 {
+  float x[W], y[W], z[W];
+  F3 get(int l) const { return {x[l], y[l], z[l]}; }
+  void set(int l, F3 v) {
+    x[l] = v.x;
+    y[l] = v.y;
+    z[l] = v.z;
+  }
+};
+
+// Copies a block's wisps into lanes and back. Only the lanes whose result is valid are
+// written back; the others are left to the per-wisp kernels.
+struct Block {
+  int n = 0;
+  std::uint32_t base[W];
+  int bad[W];
+
+  Block(const WispSystem& s, const std::uint32_t* wisps) {
+    n = static_cast<int>(s.node_begin[wisps[0] + 1] - s.node_begin[wisps[0]]);
+    for (int l = 0; l < W; ++l) {
+      base[l] = s.node_begin[wisps[l]];
+      bad[l] = 0;
+    }
+  }
+  void load(V3* dst, const std::vector<Vec3f>& src) const {
+    for (int i = 0; i < n; ++i)
+      for (int l = 0; l < W; ++l) dst[i].set(l, {src[base[l] + i].x(), src[base[l] + i].y(), src[base[l] + i].z()});
+  }
+  void store(std::vector<Vec3f>& dst, const V3* src, const float* free = nullptr) const {
+    for (int l = 0; l < W; ++l) {
+      if (bad[l]) continue;
+      for (int i = 0; i < n; ++i)
+        if (!free || free[i * W + l] != 0.0f) dst[base[l] + i] = Vec3f(src[i].x[l], src[i].y[l], src[i].z[l]);
+    }
+  }
+  template <class T>
+  void load(float* dst, const std::vector<T>& src, int per_node) const {
+    for (int i = 0; i < n; ++i)
+      for (int q = 0; q < per_node; ++q)
+        for (int l = 0; l < W; ++l) dst[(i * per_node + q) * W + l] = static_cast<float>(src[(base[l] + i) * per_node + q]);
+  }
+  void store(std::vector<float>& dst, const float* src, int per_node) const {
+    for (int l = 0; l < W; ++l) {
+      if (bad[l]) continue;
+      for (int i = 0; i < n; ++i)
+        for (int q = 0; q < per_node; ++q) dst[(base[l] + i) * per_node + q] = src[(i * per_node + q) * W + l];
+    }
+  }
+};
+
+// wisp_forces_and_velocities for a block (see there for the physics, §3.2, §3.3, §5.1).
+void velocities(WispSystem& s, const std::uint32_t* wisps, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                const Vec3f& gravity, const Wind& wind, float h) {
+  Block blk(s, wisps);
+  const int n = blk.n;
+  V3 x[N], v[N], e1[N], e2[N], nn[N], bl[N], acc[N], seg_t[N];
+  float rest_len[N * W], free[N * W], r_rest[N * W], seg_len[N * W];
+  float r[N * Q * W], rdot[N * Q * W], racc[N * Q * W];
+  blk.load(x, s.x);
+  blk.load(v, s.v);
+  blk.load(e1, s.e1);
+  blk.load(e2, s.e2);
+  blk.load(nn, s.n);
+  blk.load(bl, s.bend_local);
+  blk.load(rest_len, s.rest_len, 1);
+  blk.load(free, s.pinned, 1);
+  for (float& f : free) f = f == 0.0f ? 1.0f : 0.0f;
+  blk.load(r_rest, s.r_rest, 1);
+  blk.load(r, s.r, Q);
+  blk.load(rdot, s.rdot, Q);
+  int* bad = blk.bad;
+
+  const F3 g{gravity.x(), gravity.y(), gravity.z()};
+  const Vec3f wind_v = wind.acceleration();
+  const F3 wa{wind_v.x(), wind_v.y(), wind_v.z()};
+  const bool windy = wind.active();
+  for (int i = 0; i < n; ++i) {
+    LANES {
+      F3 a = sub(g, mul(p.air_drag, v[i].get(l)));
+      if (windy && i > 0) {
+        const F3 d = sub(x[i].get(l), x[i - 1].get(l));
+        const float n2 = dot(d, d);
+        const F3 t = n2 > 1e-24f ? quot(d, std::sqrt(n2)) : F3{0.0f, 0.0f, 0.0f};
+        a = add(a, sub(wa, mul(dot(wa, t), t)));
+      }
+      acc[i].set(l, a);
+    }
+  }
+  // Axial springs.
+  for (int i = 1; i < n; ++i) {
+    LANES {
+      const F3 d = sub(x[i].get(l), x[i - 1].get(l));
+      const float len = std::sqrt(dot(d, d));
+      seg_len[i * W + l] = len;
+      bad[l] |= !(len > 0.0f);
+      const F3 t = quot(d, len);
+      seg_t[i].set(l, t);
+      const float f =
+          p.axial_stiffness * (len - rest_len[i * W + l]) + p.axial_damping * dot(sub(v[i].get(l), v[i - 1].get(l)), t);
+      acc[i - 1].set(l, add(acc[i - 1].get(l), mul(f, t)));
+      acc[i].set(l, sub(acc[i].get(l), mul(f, t)));
+    }
+  }
+  // Bending springs: the angle's atan2 is the library's, lane by lane, between two
+  // vector loops.
+  float sin_angle[W], cos_angle[W], angle[W];
+  F3 axis[W];
+  for (int i = 2; i < n; ++i) {
+    LANES {
+      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+      const F3 b = bl[i].get(l);
+      const F3 local = add(add(mul(b.x, e1[i - 2].get(l)), mul(b.y, e2[i - 2].get(l))), mul(b.z, nn[i - 2].get(l)));
+      const F3 target = minimal_rotate(nn[i - 2].get(l), t_prev, local, bad[l]);
+      axis[l] = cross(t, target);
+      sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
+      cos_angle[l] = dot(target, t);
+    }
+    for (int l = 0; l < W; ++l) angle[l] = sin_angle[l] > 1e-7f ? std::atan2(sin_angle[l], cos_angle[l]) : 0.0f;
+    LANES {
+      const float len = seg_len[i * W + l], len_prev = seg_len[(i - 1) * W + l];
+      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+      const bool bends = sin_angle[l] > 1e-7f;
+      const float ra = rest_len[i * W + l], rb = rest_len[(i - 1) * W + l];
+      const float l0 = rb < ra ? rb : ra;
+      const float torque = p.bending_stiffness * angle[l] * l0 * l0;
+      const F3 a = quot(axis[l], sin_angle[l]);
+      const F3 zero{0.0f, 0.0f, 0.0f};
+      const F3 fk = pick(bends, mul(torque / len, cross(a, t)), zero);
+      const F3 fk2 = pick(bends, mul(torque / len_prev, cross(a, t_prev)), zero);
+      const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
+      const F3 damp = mul(p.bending_damping, sub(dv, mul(dot(dv, t), t)));
+      acc[i].set(l, add(acc[i].get(l), sub(fk, damp)));
+      acc[i - 2].set(l, add(acc[i - 2].get(l), fk2));
+      acc[i - 1].set(l, sub(acc[i - 1].get(l), sub(add(fk, fk2), damp)));
+    }
+  }
+  // Envelope: radial springs, then ring springs, on the free nodes.
+  const float sqrt2 = std::sqrt(2.0f);
+  for (int i = 0; i < n; ++i) {
+    LANES {
+      const bool is_free = free[i * W + l] != 0.0f;
+      const float r0 = r_rest[i * W + l];
+      const F3 frame_acc = sub(g, acc[i].get(l));
+      const F3 u1 = e1[i].get(l), u2 = e2[i].get(l);
+      const F3 dirs[Q] = {u1, u2, {-u1.x, -u1.y, -u1.z}, {-u2.x, -u2.y, -u2.z}};
+      const F3 vel = v[i].get(l);
+      F3 reaction{0.0f, 0.0f, 0.0f};
+      float ra_[Q], rd_[Q], out[Q];
+      EACH_Q {
+        ra_[q] = r[(i * Q + q) * W + l];
+        rd_[q] = rdot[(i * Q + q) * W + l];
+      }
+      EACH_Q {
+        const float rr = ra_[q], rd = rd_[q];
+        const float compress = -p.radial_stiffness * (rr - r0) * (r0 / rr);
+        const float stretch = -p.radial_stiffness * p.radial_stretch * (rr - r0);
+        const float spring = rr < r0 ? compress : stretch;
+        const float radial = spring - p.radial_damping * rd;
+        reaction = sub(reaction, mul(p.envelope_mass * radial, dirs[q]));
+        out[q] = radial + dot(frame_acc, dirs[q]) - p.air_drag * (dot(vel, dirs[q]) + rd);
+      }
+      const float d0 = r0 * sqrt2;
+      EACH_Q {
+        const int q2 = (q + 1) % Q;
+        const float ra = ra_[q], rb = ra_[q2];
+        const float d = std::sqrt(ra * ra + rb * rb);
+        bad[l] |= is_free & !(d > 0.0f);
+        const float ddot = (ra * rd_[q] + rb * rd_[q2]) / d;
+        const float tension = p.ring_stiffness * (d - d0) + p.ring_damping * ddot;
+        out[q] -= tension * ra / d;
+        out[q2] -= tension * rb / d;
+      }
+      EACH_Q racc[(i * Q + q) * W + l] = is_free ? out[q] : 0.0f;
+      acc[i].set(l, pick(is_free, add(acc[i].get(l), reaction), acc[i].get(l)));
+    }
+  }
+  // Velocities of the free masses.
+  for (int i = 0; i < n; ++i) {
+    LANES {
+      const bool is_free = free[i * W + l] != 0.0f;
+      const F3 vi = v[i].get(l);
+      v[i].set(l, pick(is_free, add(vi, mul(h, acc[i].get(l))), vi));
+    }
+  }
+  for (int j = 0; j < n * Q; ++j) {
+    LANES {
+      const float rd = rdot[j * W + l];
+      rdot[j * W + l] = free[j / Q * W + l] != 0.0f ? rd + h * racc[j * W + l] : rd;
+    }
+  }
+  blk.store(s.v, v, free);
+  blk.store(s.rdot, rdot, Q);
+  for (int l = 0; l < W; ++l)
+    if (bad[l]) wisp_forces_and_velocities(s, wisps[l], p, head_rot, gravity, wind, h);
+}
+
+// wisp_positions (and wisp_frames) for a block (§3.3, §5.1 step 4).
+void positions(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, float h) {
+  Block blk(s, wisps);
+  const int n = blk.n;
+  V3 x[N], v[N], e1[N], e2[N], nn[N];
+  float free[N * W], r_rest[N * W], r[N * Q * W], rdot[N * Q * W];
+  blk.load(x, s.x);
+  blk.load(v, s.v);
+  blk.load(free, s.pinned, 1);
+  for (float& f : free) f = f == 0.0f ? 1.0f : 0.0f;
+  blk.load(r_rest, s.r_rest, 1);
+  blk.load(r, s.r, Q);
+  blk.load(rdot, s.rdot, Q);
+  int* bad = blk.bad;
+
+  for (int i = 0; i < n; ++i) {
+    LANES {
+      const F3 xi = x[i].get(l);
+      x[i].set(l, pick(free[i * W + l] != 0.0f, add(xi, mul(h, v[i].get(l))), xi));
+    }
+  }
+  // Section frames (wisp_frames): normals bisecting the segments, e1 carried root to tip
+  // by minimal rotation.
+  V3 prev_t;
+  LANES {
+    const F3 t = unit(sub(x[1].get(l), x[0].get(l)), bad[l]);
+    nn[0].set(l, t);
+    prev_t.set(l, t);
+  }
+  for (int i = 1; i + 1 < n; ++i) {
+    LANES {
+      const F3 t = unit(sub(x[i + 1].get(l), x[i].get(l)), bad[l]);
+      nn[i].set(l, unit(add(prev_t.get(l), t), bad[l]));
+      prev_t.set(l, t);
+    }
+  }
+  LANES {
+    nn[n - 1].set(l, prev_t.get(l));
+    const F3 re{root_e1[l].x(), root_e1[l].y(), root_e1[l].z()};
+    const F3 n0 = nn[0].get(l);
+    const F3 first = unit(sub(re, mul(dot(re, n0), n0)), bad[l]);
+    e1[0].set(l, first);
+    e2[0].set(l, cross(n0, first));
+  }
+  for (int i = 1; i < n; ++i) {
+    LANES {
+      const F3 ni = nn[i].get(l);
+      F3 a = minimal_rotate(nn[i - 1].get(l), ni, e1[i - 1].get(l), bad[l]);
+      a = unit(sub(a, mul(dot(a, ni), ni)), bad[l]);
+      e1[i].set(l, a);
+      e2[i].set(l, cross(ni, a));
+    }
+  }
+  // Envelope radii within [0.25, 2] rest radii.
+  for (int i = 0; i < n; ++i) {
+    LANES {
+      const bool is_free = free[i * W + l] != 0.0f;
+      const float r_min = 0.25f * r_rest[i * W + l], r_max = 2.0f * r_rest[i * W + l];
+      EACH_Q {
+        const float ri = r[(i * Q + q) * W + l];
+        const float rd = rdot[(i * Q + q) * W + l];
+        const float moved = ri + h * rd;
+        const bool low = moved < r_min, high = moved > r_max;
+        const float rd_low = rd < 0.0f ? 0.0f : rd, rd_high = 0.0f < rd ? 0.0f : rd;
+        const float r_cap = high ? r_max : moved, rd_cap = high ? rd_high : rd;
+        const float r_new = low ? r_min : r_cap;
+        const float rd_new = low ? rd_low : rd_cap;
+        r[(i * Q + q) * W + l] = is_free ? r_new : ri;
+        rdot[(i * Q + q) * W + l] = is_free ? rd_new : rd;
+      }
+    }
+  }
+  blk.store(s.x, x, free);
+  blk.store(s.n, nn);
+  blk.store(s.e1, e1);
+  blk.store(s.e2, e2);
+  blk.store(s.r, r, Q);
+  blk.store(s.rdot, rdot, Q);
+  for (int l = 0; l < W; ++l)
+    if (bad[l]) wisp_positions(s, wisps[l], root_e1[l], h);
+}
+
+}  // namespace
+
+Kernels kernels() { return {velocities, positions}; }
+
+}  // namespace hairbench::kernels::wisp_soa::PLANTE_SOA_VARIANT
