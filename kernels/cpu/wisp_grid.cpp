@@ -1,6 +1,7 @@
 #include "kernels/cpu/wisp_grid.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace hairbench::kernels {
@@ -15,6 +16,11 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
     for (std::uint32_t k = first > b ? first - 1 : b; k + 1 < e; ++k) g.seg.push_back(k);
   }
   const std::size_t n = g.seg.size();
+  g.wisp.resize(n);
+  g.vol.resize(n);
+  g.mass.resize(n);
+  g.mass_widest.resize(n);
+  g.mass_free.resize(n);
   g.lo.resize(n);
   g.hi.resize(n);
   g.cell_lo.resize(n);
@@ -36,8 +42,15 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
         const Vec3f p = envelope_point(s, k, q);
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
+        if (k > g.seg[i]) g.mass[i][1 + q] = p;
       }
     }
+    const std::uint32_t k = g.seg[i] + 1;
+    g.wisp[i] = s.node_wisp[k];
+    g.vol[i] = SegmentVolume(s, g.seg[i]);
+    g.mass[i][0] = s.x[k];
+    g.mass_widest[i] = widest_radius(s, k);
+    g.mass_free[i] = !s.pinned[k];
     g.lo[i] = lo;
     g.hi[i] = hi;
     all_lo = all_lo.cwiseMin(lo);
@@ -65,33 +78,98 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
         for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) ++g.cell_start[index(x, y, z) + 1];
   }
   for (std::size_t c = 0; c < cells; ++c) g.cell_start[c + 1] += g.cell_start[c];
-  g.cell_items.resize(g.cell_start[cells]);
-  std::vector<std::uint32_t> fill(g.cell_start.begin(), g.cell_start.end() - 1);
+  const std::size_t items = g.cell_start[cells];
+  g.cell_items.resize(items);
+  for (int a = 0; a < 3; ++a) {
+    g.item_lo[a].resize(items);
+    g.item_hi[a].resize(items);
+  }
+  g.cell_fill.assign(g.cell_start.begin(), g.cell_start.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x)
-          g.cell_items[fill[index(x, y, z)]++] = static_cast<std::uint32_t>(i);
+        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+          const std::uint32_t it = g.cell_fill[index(x, y, z)]++;
+          g.cell_items[it] = static_cast<std::uint32_t>(i);
+          for (int a = 0; a < 3; ++a) {
+            g.item_lo[a][it] = g.lo[i][a];
+            g.item_hi[a][it] = g.hi[i][a];
+          }
+        }
 }
+
+namespace {
+
+// The masses of segment i (node seg[i] + 1 and its envelope) tested against the volume
+// of segment j; appends contacts to out.
+void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, std::vector<WispContact>& out) {
+  if (!g.mass_free[i]) return;
+  const SegmentVolume& vol = g.vol[j];
+  const auto& m = g.mass[i];
+  // The masses lie within mass_widest of node k, and the volume within its widest
+  // radius of the axis (SegmentVolume::contains): where the two balls around them
+  // cannot meet, none of the five masses is inside and their tests are skipped. The
+  // margin is far above rounding, so no mass the full test finds is skipped (issue 10).
+  if (vol.len2 > 0.0f) {
+    const float u = std::clamp((m[0] - vol.xa).dot(vol.d) / vol.len2, 0.0f, 1.0f);
+    const float reach = 1.01f * (g.mass_widest[i] + vol.widest);
+    if ((m[0] - (vol.xa + u * vol.d)).squaredNorm() > reach * reach) return;
+  }
+  const std::uint32_t k = g.seg[i] + 1;
+  for (int q = 0; q < kMassesPerSegment; ++q) {
+    const float u = vol.contains(s, m[q]);
+    if (u < 0.0f) continue;
+    if (q == 0)
+      out.push_back({k, vol.a, u, 0});
+    else
+      out.push_back({static_cast<std::uint32_t>(kEnvelopePerSection * k + q - 1), vol.a, u, 1});
+  }
+}
+
+// Items [b, e) of cells whose boxes meet [lo, hi] (compared as the original
+// (lo > hi).any() rejection, so NaN boxes are kept alike), as bits from b on; e - b <= 32.
+std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e, const Vec3f& lo, const Vec3f& hi) {
+  std::uint32_t bits = 0;
+  for (std::uint32_t it = b; it < e; ++it) {
+    bool meet = true;
+    for (int a = 0; a < 3; ++a) meet &= !(lo[a] > g.item_hi[a][it]) & !(g.item_lo[a][it] > hi[a]);
+    bits |= static_cast<std::uint32_t>(meet) << (it - b);
+  }
+  return bits;
+}
+
+}  // namespace
 
 void grid_contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                    std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
   auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
   for (std::size_t i = begin; i < end; ++i) {
     const std::uint32_t a = g.seg[i];
-    const std::uint32_t wa = s.node_wisp[a];
+    const auto i32 = static_cast<std::uint32_t>(i);
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
           const std::size_t c = index(x, y, z);
-          for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it) {
-            const std::uint32_t j = g.cell_items[it];
-            if (j <= i || mailbox[j] == i) continue;
-            mailbox[j] = static_cast<std::uint32_t>(i);
-            const std::uint32_t b = g.seg[j];
-            if (s.node_wisp[b] == wa && b - a < 3) continue;  // b > a within a wisp
-            if ((g.lo[i].array() > g.hi[j].array()).any() || (g.lo[j].array() > g.hi[i].array()).any()) continue;
-            segment_pair_contacts(s, a, b, out);
+          // A cell's items ascend: the later segments start after i.
+          const std::uint32_t stop = g.cell_start[c + 1];
+          std::uint32_t it = static_cast<std::uint32_t>(
+              std::upper_bound(g.cell_items.begin() + g.cell_start[c], g.cell_items.begin() + stop, i32) -
+              g.cell_items.begin());
+          // The box test first, over a run of items at once; the mailbox, wisp and
+          // narrow-phase tests then for the boxes that meet, in item order: the same
+          // pairs in the same order as testing each item in turn, since the box test
+          // does not depend on the cell.
+          for (; it < stop; it += 32) {
+            std::uint32_t bits = overlapping(g, it, std::min(stop, it + 32), g.lo[i], g.hi[i]);
+            for (; bits != 0; bits &= bits - 1) {
+              const std::uint32_t j = g.cell_items[it + static_cast<std::uint32_t>(std::countr_zero(bits))];
+              if (mailbox[j] == i32) continue;
+              mailbox[j] = i32;
+              const std::uint32_t b = g.seg[j];
+              if (g.wisp[j] == g.wisp[i] && b - a < 3) continue;  // b > a within a wisp
+              masses_in(g, s, i, j, out);
+              masses_in(g, s, j, i, out);
+            }
           }
         }
   }

@@ -207,15 +207,24 @@ struct WispContact {
   std::uint8_t envelope;
 };
 
-// Is p inside the volume of segment (a, a+1), bounded by its two sections? Returns u in
-// [0,1] when inside, a negative value otherwise. The volume is swept by the sections'
-// quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along the axis.
-float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p);
+// Widest envelope radius of node k: its envelope masses lie within it of x[k].
+float widest_radius(const WispSystem& s, std::uint32_t k);
 
-// Narrow phase for one pair of segments whose bounding boxes overlap: the masses of each
-// segment tested against the other's volume (§4.1); appends contacts to out. A segment
-// (k-1, k) owns the masses of node k, so every free mass belongs to exactly one segment.
-void segment_pair_contacts(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vector<WispContact>& out);
+// The volume of segment (a, a+1), bounded by its two sections: swept by the sections'
+// quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along the axis.
+// Its axis is set up once for the tests of many points (issue 10).
+struct SegmentVolume {
+  std::uint32_t a = 0;
+  Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
+  float len2 = 0.0f;
+  float widest = 0.0f;     // widest envelope radius at either end: the volume lies within it of the axis
+  float reach2 = 0.0f;     // (1.01 widest)^2
+
+  SegmentVolume() = default;
+  SegmentVolume(const WispSystem& s, std::uint32_t seg);
+  // Is p inside? Returns u in [0,1] when inside, a negative value otherwise.
+  float contains(const WispSystem& s, const Vec3f& p) const;
+};
 
 // The response of every contact from the current state (§4.1), accumulated then applied
 // as averages per mass: quasi-parallel wisps (orientations within acos(parallel_cos),
