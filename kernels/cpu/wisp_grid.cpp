@@ -6,6 +6,16 @@
 
 namespace hairbench::kernels {
 
+namespace {
+
+void set_mass(SegmentMasses& m, int q, const Vec3f& p) {
+  m.x[q] = p.x();
+  m.y[q] = p.y();
+  m.z[q] = p.z();
+}
+
+}  // namespace
+
 void grid_build(SegmentGrid& g, const WispSystem& s) {
   g.seg.clear();
   for (std::size_t w = 0; w < s.wisp_count(); ++w) {
@@ -19,7 +29,6 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
   g.wisp.resize(n);
   g.vol.resize(n);
   g.mass.resize(n);
-  g.mass_widest.resize(n);
   g.mass_free.resize(n);
   g.lo.resize(n);
   g.hi.resize(n);
@@ -42,14 +51,13 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
         const Vec3f p = envelope_point(s, k, q);
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
-        if (k > g.seg[i]) g.mass[i][1 + q] = p;
+        if (k > g.seg[i]) set_mass(g.mass[i], 1 + q, p);
       }
     }
     const std::uint32_t k = g.seg[i] + 1;
     g.wisp[i] = s.node_wisp[k];
     g.vol[i] = SegmentVolume(s, g.seg[i]);
-    g.mass[i][0] = s.x[k];
-    g.mass_widest[i] = widest_radius(s, k);
+    for (int q : {0, kMassesPerSegment, kMassesPerSegment + 1, kMassesPerSegment + 2}) set_mass(g.mass[i], q, s.x[k]);
     g.mass_free[i] = !s.pinned[k];
     g.lo[i] = lo;
     g.hi[i] = hi;
@@ -103,20 +111,26 @@ namespace {
 // The masses of segment i (node seg[i] + 1 and its envelope) tested against the volume
 // of segment j; appends contacts to out.
 void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, std::vector<WispContact>& out) {
-  if (!g.mass_free[i]) return;
   const SegmentVolume& vol = g.vol[j];
-  const auto& m = g.mass[i];
-  // The masses lie within mass_widest of node k, and the volume within its widest
-  // radius of the axis (SegmentVolume::contains): where the two balls around them
-  // cannot meet, none of the five masses is inside and their tests are skipped. The
-  // margin is far above rounding, so no mass the full test finds is skipped (issue 10).
-  if (vol.len2 > 0.0f) {
-    const float u = std::clamp((m[0] - vol.xa).dot(vol.d) / vol.len2, 0.0f, 1.0f);
-    const float reach = 1.01f * (g.mass_widest[i] + vol.widest);
-    if ((m[0] - (vol.xa + u * vol.d)).squaredNorm() > reach * reach) return;
+  if (!g.mass_free[i] || !(vol.len2 > 0.0f)) return;  // contains finds nothing
+  // Cheap bounds first, for all the masses at once (issue 10): the axial one of
+  // SegmentVolume::contains, widened by far more than rounding (the sums here may round
+  // otherwise than Eigen's), and the distance to the axis within vol.reach2. Most masses
+  // are outside one of them, and every mass contains finds is inside both; contains
+  // then runs on the others alone, without the frame's square root and divisions.
+  const SegmentMasses& m = g.mass[i];
+  alignas(32) std::int32_t near[SegmentMasses::kWidth];
+  for (int q = 0; q < SegmentMasses::kWidth; ++q) {
+    const float px = m.x[q] - vol.xa.x(), py = m.y[q] - vol.xa.y(), pz = m.z[q] - vol.xa.z();
+    const float u = (px * vol.d.x() + py * vol.d.y() + pz * vol.d.z()) / vol.len2;
+    const float lx = px - u * vol.d.x(), ly = py - u * vol.d.y(), lz = pz - u * vol.d.z();
+    near[q] = (u >= -1e-3f) & (u <= 1.001f) & (lx * lx + ly * ly + lz * lz <= vol.reach2);
   }
+  std::uint32_t bits = 0;
+  for (int q = 0; q < kMassesPerSegment; ++q) bits |= static_cast<std::uint32_t>(near[q]) << q;
   const std::uint32_t k = g.seg[i] + 1;
-  for (int q = 0; q < kMassesPerSegment; ++q) {
+  for (; bits != 0; bits &= bits - 1) {
+    const int q = std::countr_zero(bits);
     const float u = vol.contains(s, m[q]);
     if (u < 0.0f) continue;
     if (q == 0)

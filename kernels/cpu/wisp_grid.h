@@ -15,6 +15,14 @@ namespace hairbench::kernels {
 // order they are tested (§4.1).
 inline constexpr int kMassesPerSegment = 1 + kEnvelopePerSection;
 
+// Those masses coordinate by coordinate, padded to a vector's width with copies of the
+// first: the cheap bounds of SegmentVolume::contains run on all of them at once.
+struct SegmentMasses {
+  static constexpr int kWidth = 8;
+  alignas(32) float x[kWidth], y[kWidth], z[kWidth];
+  Vec3f operator[](int q) const { return {x[q], y[q], z[q]}; }
+};
+
 struct SegmentGrid {
   // Segments that take part: (seg[i], seg[i] + 1), from each wisp's first free node on
   // (the pinned first segment is inside the head, §3.2).
@@ -23,11 +31,10 @@ struct SegmentGrid {
   std::vector<Vec3f> lo, hi;                       // bounding box of skeleton + envelope masses
   std::vector<Eigen::Vector3i> cell_lo, cell_hi;   // cells each box covers
   // Per segment, set up once per detection for its tests against every other one
-  // (issue 10): its volume, the positions of the masses it owns, their widest radius
-  // around node seg[i] + 1, and whether that node is free.
+  // (issue 10): its volume, the positions of the masses it owns, and whether they are
+  // free (node seg[i] + 1 is not pinned).
   std::vector<SegmentVolume> vol;
-  std::vector<std::array<Vec3f, kMassesPerSegment>> mass;
-  std::vector<float> mass_widest;
+  std::vector<SegmentMasses> mass;
   std::vector<std::uint8_t> mass_free;
   Vec3f origin = Vec3f::Zero();
   float cell = 1.0f;

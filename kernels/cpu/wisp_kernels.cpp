@@ -555,12 +555,6 @@ float SegmentVolume::contains(const WispSystem& s, const Vec3f& p) const {
   const float u = (p - xa).dot(d) / len2;
   if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
   const Vec3f lateral = p - (xa + u * d);
-  // alpha^2 + beta^2 below is |lateral|^2 (lateral is normal to the axis, e1 and e2 an
-  // orthonormal basis of that plane), and the interpolated radii are at most `widest`:
-  // beyond `reach` the point is outside, found without the frame's square root and
-  // divisions. Three quarters of the points that pass the axial test are outside
-  // (issue 10); the 1% margin is far above rounding, so no inside point is rejected.
-  if (lateral.squaredNorm() > reach2) return -1.0f;
   // The section axes interpolated along the segment, made orthonormal about its axis.
   Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
   e1 = unit_or(e1 - e1.dot(t) * t, t_orth);

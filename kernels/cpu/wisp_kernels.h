@@ -218,7 +218,11 @@ struct SegmentVolume {
   Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
   float len2 = 0.0f;
   float widest = 0.0f;     // widest envelope radius at either end: the volume lies within it of the axis
-  float reach2 = 0.0f;     // (1.01 widest)^2
+  // (1.01 widest)^2. In contains, alpha^2 + beta^2 is the squared distance to the axis
+  // (e1, e2 an orthonormal basis of the plane normal to it) and the interpolated radii
+  // are at most `widest`: a point farther than that from the axis is outside. The 1%
+  // margin is far above rounding, so a test on this bound rejects no inside point.
+  float reach2 = 0.0f;
 
   SegmentVolume() = default;
   SegmentVolume(const WispSystem& s, std::uint32_t seg);
