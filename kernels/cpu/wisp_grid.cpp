@@ -143,12 +143,16 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
 // Items [b, e) of cells whose boxes meet [lo, hi] (compared as the original
 // (lo > hi).any() rejection, so NaN boxes are kept alike), as bits from b on; e - b <= 32.
 std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e, const Vec3f& lo, const Vec3f& hi) {
+  // Box tests into an array first (vector code), then gathered into bits.
+  const float *lx = g.item_lo[0].data() + b, *ly = g.item_lo[1].data() + b, *lz = g.item_lo[2].data() + b;
+  const float *hx = g.item_hi[0].data() + b, *hy = g.item_hi[1].data() + b, *hz = g.item_hi[2].data() + b;
+  const std::uint32_t count = e - b;
+  alignas(32) std::int32_t meet[32];
+  for (std::uint32_t t = 0; t < count; ++t)
+    meet[t] = !(lo.x() > hx[t]) & !(lx[t] > hi.x()) & !(lo.y() > hy[t]) & !(ly[t] > hi.y()) & !(lo.z() > hz[t]) &
+              !(lz[t] > hi.z());
   std::uint32_t bits = 0;
-  for (std::uint32_t it = b; it < e; ++it) {
-    bool meet = true;
-    for (int a = 0; a < 3; ++a) meet &= !(lo[a] > g.item_hi[a][it]) & !(g.item_lo[a][it] > hi[a]);
-    bits |= static_cast<std::uint32_t>(meet) << (it - b);
-  }
+  for (std::uint32_t t = 0; t < count; ++t) bits |= static_cast<std::uint32_t>(meet[t]) << t;
   return bits;
 }
 
