@@ -112,12 +112,12 @@ namespace {
 // of segment j; appends contacts to out.
 void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, std::vector<WispContact>& out) {
   const SegmentVolume& vol = g.vol[j];
-  if (!g.mass_free[i] || !(vol.len2 > 0.0f)) return;  // contains finds nothing
-  // Cheap bounds first, for all the masses at once (issue 10): the axial one of
-  // SegmentVolume::contains, widened by far more than rounding (the sums here may round
-  // otherwise than Eigen's), and the distance to the axis within vol.reach2. Most masses
-  // are outside one of them, and every mass contains finds is inside both; contains
-  // then runs on the others alone, without the frame's square root and divisions.
+  if (!g.mass_free[i] || !(vol.len2 > 0.0f)) return;  // a degenerate volume holds nothing
+  // Cheap bounds first, for all the masses at once (issue 10): the axial one of the
+  // test below, widened by far more than rounding (these sums may round otherwise), and
+  // the distance to the axis within vol.reach2. Most masses are outside one of them, and
+  // every mass the full test finds is inside both; the full test, with the frame's
+  // square root and divisions, runs only where some mass is.
   const SegmentMasses& m = g.mass[i];
   alignas(32) std::int32_t near[SegmentMasses::kWidth];
   for (int q = 0; q < SegmentMasses::kWidth; ++q) {
@@ -128,11 +128,56 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
   }
   std::uint32_t bits = 0;
   for (int q = 0; q < kMassesPerSegment; ++q) bits |= static_cast<std::uint32_t>(near[q]) << q;
+  if (bits == 0) return;
+  // The full test (SegmentVolume), for all the masses at once: each lane performs the
+  // operations of the per-point test of plante_wisp before issue 10 in its order (Eigen's
+  // 3-vector dot products and norms sum x + (y + z); its quotients by a scalar are
+  // divisions),
+  // so the same contacts are found with the same axial parameters.
+  // The segment's values, as scalars read once: the lanes then run as vector code.
+  const float xa[3] = {vol.xa.x(), vol.xa.y(), vol.xa.z()}, d[3] = {vol.d.x(), vol.d.y(), vol.d.z()};
+  const float t[3] = {vol.t.x(), vol.t.y(), vol.t.z()}, o[3] = {vol.t_orth.x(), vol.t_orth.y(), vol.t_orth.z()};
+  const Vec3f &e1a = s.e1[vol.a], &e1b = s.e1[vol.a + 1];
+  const float ea[3] = {e1a.x(), e1a.y(), e1a.z()}, eb[3] = {e1b.x(), e1b.y(), e1b.z()};
+  const float* r_at_a = &s.r[kEnvelopePerSection * vol.a];
+  float ra[kEnvelopePerSection], dr[kEnvelopePerSection];
+  for (int q = 0; q < kEnvelopePerSection; ++q) {
+    ra[q] = r_at_a[q];
+    dr[q] = r_at_a[q + kEnvelopePerSection] - r_at_a[q];
+  }
+  const float len2 = vol.len2;
+  alignas(32) float axial[SegmentMasses::kWidth];
+  for (int q = 0; q < SegmentMasses::kWidth; ++q) {
+    const float px = m.x[q] - xa[0], py = m.y[q] - xa[1], pz = m.z[q] - xa[2];
+    const float u = (px * d[0] + (py * d[1] + pz * d[2])) / len2;
+    const float lx = m.x[q] - (xa[0] + u * d[0]), ly = m.y[q] - (xa[1] + u * d[1]), lz = m.z[q] - (xa[2] + u * d[2]);
+    // The section axes interpolated along the segment, made orthonormal about its axis.
+    const float w = 1.0f - u;
+    float ex = w * ea[0] + u * eb[0], ey = w * ea[1] + u * eb[1], ez = w * ea[2] + u * eb[2];
+    const float et = ex * t[0] + (ey * t[1] + ez * t[2]);
+    ex = ex - et * t[0];
+    ey = ey - et * t[1];
+    ez = ez - et * t[2];
+    const float n2 = ex * ex + (ey * ey + ez * ez);
+    const bool unit = n2 > 1e-24f;
+    const float len = std::sqrt(n2);
+    ex = unit ? ex / len : o[0];
+    ey = unit ? ey / len : o[1];
+    ez = unit ? ez / len : o[2];
+    const float fx = t[1] * ez - t[2] * ey, fy = t[2] * ex - t[0] * ez, fz = t[0] * ey - t[1] * ex;
+    const float alpha = lx * ex + (ly * ey + lz * ez), beta = lx * fx + (ly * fy + lz * fz);
+    const float r_alpha = alpha >= 0.0f ? ra[0] + u * dr[0] : ra[2] + u * dr[2];
+    const float r_beta = beta >= 0.0f ? ra[1] + u * dr[1] : ra[3] + u * dr[3];
+    const float f = (alpha / r_alpha) * (alpha / r_alpha) + (beta / r_beta) * (beta / r_beta);
+    near[q] = (u >= 0.0f) & (u <= 1.0f) & (f < 1.0f);
+    axial[q] = u;
+  }
+  bits = 0;
+  for (int q = 0; q < kMassesPerSegment; ++q) bits |= static_cast<std::uint32_t>(near[q]) << q;
   const std::uint32_t k = g.seg[i] + 1;
   for (; bits != 0; bits &= bits - 1) {
     const int q = std::countr_zero(bits);
-    const float u = vol.contains(s, m[q]);
-    if (u < 0.0f) continue;
+    const float u = axial[q];
     if (q == 0)
       out.push_back({k, vol.a, u, 0});
     else

@@ -534,10 +534,15 @@ void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float d
   }
 }
 
+namespace {
+
+// Widest envelope radius of node k: its envelope masses lie within it of x[k].
 float widest_radius(const WispSystem& s, std::uint32_t k) {
   const float* r = &s.r[kEnvelopePerSection * k];
   return std::max(std::max(r[0], r[1]), std::max(r[2], r[3]));
 }
+
+}  // namespace
 
 SegmentVolume::SegmentVolume(const WispSystem& s, std::uint32_t seg) : a(seg), xa(s.x[seg]), d(s.x[seg + 1] - xa) {
   len2 = d.squaredNorm();
@@ -545,27 +550,8 @@ SegmentVolume::SegmentVolume(const WispSystem& s, std::uint32_t seg) : a(seg), x
     t = d / std::sqrt(len2);
     t_orth = t.unitOrthogonal();
   }
-  widest = std::max(widest_radius(s, seg), widest_radius(s, seg + 1));
-  const float reach = 1.01f * widest;
+  const float reach = 1.01f * std::max(widest_radius(s, seg), widest_radius(s, seg + 1));
   reach2 = reach * reach;
-}
-
-float SegmentVolume::contains(const WispSystem& s, const Vec3f& p) const {
-  if (!(len2 > 0.0f)) return -1.0f;
-  const float u = (p - xa).dot(d) / len2;
-  if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
-  const Vec3f lateral = p - (xa + u * d);
-  // The section axes interpolated along the segment, made orthonormal about its axis.
-  Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
-  e1 = unit_or(e1 - e1.dot(t) * t, t_orth);
-  const Vec3f e2 = t.cross(e1);
-  const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
-  const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
-  const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
-  const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u);
-  const float rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
-  const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
-  return f < 1.0f ? u : -1.0f;
 }
 
 void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,

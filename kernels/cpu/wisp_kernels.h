@@ -207,27 +207,27 @@ struct WispContact {
   std::uint8_t envelope;
 };
 
-// Widest envelope radius of node k: its envelope masses lie within it of x[k].
-float widest_radius(const WispSystem& s, std::uint32_t k);
-
-// The volume of segment (a, a+1), bounded by its two sections: swept by the sections'
-// quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along the axis.
-// Its axis is set up once for the tests of many points (issue 10).
+// The volume of segment (a, a+1), bounded by its two sections (§4.1): swept by the
+// sections' quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along
+// the axis. A point p is inside at axial parameter u = (p - xa).d / |d|^2 in [0,1] when,
+// with lateral = p - (xa + u d), e1 the section axes (1-u) e1[a] + u e1[a+1] made unit
+// and normal to t (t_orth where that vanishes), e2 = t x e1, alpha = lateral.e1, beta =
+// lateral.e2, and ra, rb the radii of the envelope masses on the sides of alpha and beta
+// interpolated at u: (alpha/ra)^2 + (beta/rb)^2 < 1. The axis is set up once per
+// detection for the tests of many points (issue 10; the test: wisp_grid.cpp).
 struct SegmentVolume {
   std::uint32_t a = 0;
   Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
   float len2 = 0.0f;
-  float widest = 0.0f;     // widest envelope radius at either end: the volume lies within it of the axis
-  // (1.01 widest)^2. In contains, alpha^2 + beta^2 is the squared distance to the axis
-  // (e1, e2 an orthonormal basis of the plane normal to it) and the interpolated radii
-  // are at most `widest`: a point farther than that from the axis is outside. The 1%
-  // margin is far above rounding, so a test on this bound rejects no inside point.
+  // (1.01 widest)^2, widest the widest envelope radius at either end. alpha^2 + beta^2
+  // is the squared distance to the axis (e1, e2 an orthonormal basis of the plane normal
+  // to it) and the interpolated radii are at most `widest`: a point farther than that
+  // from the axis is outside. The 1% margin is far above rounding, so a test on this
+  // bound rejects no inside point.
   float reach2 = 0.0f;
 
   SegmentVolume() = default;
   SegmentVolume(const WispSystem& s, std::uint32_t seg);
-  // Is p inside? Returns u in [0,1] when inside, a negative value otherwise.
-  float contains(const WispSystem& s, const Vec3f& p) const;
 };
 
 // The response of every contact from the current state (§4.1), accumulated then applied
