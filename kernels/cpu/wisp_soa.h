@@ -10,6 +10,10 @@
 
 #include "kernels/cpu/wisp_kernels.h"
 
+namespace hairbench::kernels {
+struct SegmentGrid;
+}
+
 namespace hairbench::kernels::wisp_soa {
 
 inline constexpr int kLanes = 16;
@@ -27,9 +31,14 @@ using VelocitiesFn = void (*)(WispSystem& s, const std::uint32_t* wisps, const W
 // wisp_positions for each, root_e1[l] the head-attached first axis of wisps[l].
 using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, float h);
 
+// grid_contacts (wisp_grid.h).
+using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
+                            std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+
 struct Kernels {
   VelocitiesFn velocities;
   PositionsFn positions;
+  ContactsFn contacts;
 };
 
 // The variant for this CPU.

@@ -331,6 +331,10 @@ void positions(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, 
 
 }  // namespace
 
-Kernels kernels() { return {velocities, positions}; }
+// wisp_grid_kernel.cpp
+void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
+              std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+
+Kernels kernels() { return {velocities, positions, contacts}; }
 
 }  // namespace hairbench::kernels::wisp_soa::PLANTE_SOA_VARIANT
