@@ -255,20 +255,23 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
 void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f* root_e1, float h) {
   Block blk(s, wisps, count);
   const int n = blk.n;
-  V3 x[N], v[N], e1[N], e2[N], nn[N];
-  float free[N * W], r_rest[N * W], r[N * Q * W], rdot[N * Q * W];
-  blk.load(x, s.x);
+  // The new positions and radii go to arrays of their own: a lane-wise choice written back
+  // over its input compiles to a masked store, which the loads after it cannot be
+  // forwarded from (issue 10).
+  V3 x_old[N], x[N], v[N], e1[N], e2[N], nn[N];
+  float free[N * W], r_rest[N * W], r_old[N * Q * W], rdot_old[N * Q * W], r[N * Q * W], rdot[N * Q * W];
+  blk.load(x_old, s.x);
   blk.load(v, s.v);
   blk.load(free, s.pinned, 1);
   for (float& f : free) f = f == 0.0f ? 1.0f : 0.0f;
   blk.load(r_rest, s.r_rest, 1);
-  blk.load(r, s.r, Q);
-  blk.load(rdot, s.rdot, Q);
+  blk.load(r_old, s.r, Q);
+  blk.load(rdot_old, s.rdot, Q);
   int* bad = blk.bad;
 
   for (int i = 0; i < n; ++i) {
     LANES {
-      const F3 xi = x[i].get(l);
+      const F3 xi = x_old[i].get(l);
       x[i].set(l, pick(free[i * W + l] != 0.0f, add(xi, mul(h, v[i].get(l))), xi));
     }
   }
@@ -311,8 +314,8 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
       const bool is_free = free[i * W + l] != 0.0f;
       const float r_min = 0.25f * r_rest[i * W + l], r_max = 2.0f * r_rest[i * W + l];
       EACH_Q {
-        const float ri = r[(i * Q + q) * W + l];
-        const float rd = rdot[(i * Q + q) * W + l];
+        const float ri = r_old[(i * Q + q) * W + l];
+        const float rd = rdot_old[(i * Q + q) * W + l];
         const float moved = ri + h * rd;
         const bool low = moved < r_min, high = moved > r_max;
         const float rd_low = rd < 0.0f ? 0.0f : rd, rd_high = 0.0f < rd ? 0.0f : rd;
