@@ -55,6 +55,7 @@ void WispSystem::resize_state() {
   racc.assign(kEnvelopePerSection * n, 0.0f);
   node_body.assign(n, -1);
   env_body.assign(kEnvelopePerSection * n, -1);
+  wisp_touches.assign(wisp_count(), 0);
   seg_len.assign(n, 0.0f);
   seg_t.assign(n, Vec3f::Zero());
   node_dv.assign(n, Vec3f::Zero());
@@ -422,6 +423,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
   // than its rest length, so that the reaction carries the rest of the wisp along
   // instead of tearing the spring (it may then be found inside, and moved in turn).
   bool prev_moved = false, any_moved = false;
+  std::uint8_t touches = 0;
   for (std::uint32_t k = b; k < e; ++k) {
     s.node_body[k] = -1;
     if (s.pinned[k]) {
@@ -441,6 +443,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
     const int i = nearest_sphere(body.spheres, s.x[k], gap);
     if (i >= 0 && gap < threshold) {
       s.node_body[k] = i;
+      touches = 1;
       if (gap < 0.0f) {
         const Vec3f c = body.spheres[i].head<3>();
         s.x[k] = push_out(c, body.spheres[i].w() + 0.9f * threshold, s.x[k > b ? k - 1 : k], s.x[k], s.rest_len[k]);
@@ -467,6 +470,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       const int i = nearest_sphere(body.spheres, s.x[k] + s.r[ei] * dir, gap);
       if (i < 0 || gap >= threshold) continue;
       s.env_body[ei] = i;
+      touches = 1;
       if (gap >= 0.0f) continue;
       // Entry point of the half-line x + t dir into the sphere: |x + t dir - c| = R.
       const Vec3f c = body.spheres[i].head<3>();
@@ -489,9 +493,11 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       if (vn < 0.0f) s.rdot[ei] -= vn * nrm.dot(dir);
     }
   }
+  s.wisp_touches[w] = touches;
 }
 
 void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body) {
+  if (!s.wisp_touches[w]) return;
   for (std::uint32_t k = s.node_begin[w]; k < s.node_begin[w + 1]; ++k) {
     if (s.pinned[k]) continue;
     for (int q = 0; q < kEnvelopePerSection; ++q) {
@@ -507,6 +513,7 @@ void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body) {
 }
 
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag) {
+  if (!s.wisp_touches[w]) return;
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   // The velocity change that removes the approach and damps the tangential slip of a
   // point moving at v at p against sphere i.

@@ -71,6 +71,9 @@ struct WispSystem {
 
   // Body contacts found at the last body-collision detection (sphere index, -1 none).
   std::vector<std::int32_t> node_body, env_body;
+  // Per wisp, whether that detection recorded any: the others' sliding contacts and
+  // holds have nothing to do (issue 10).
+  std::vector<std::uint8_t> wisp_touches;
   // Scratch of wisp_forces_and_velocities: length and direction of segment (k-1, k) at k.
   std::vector<float> seg_len;
   std::vector<Vec3f> seg_t;
