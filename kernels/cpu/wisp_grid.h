@@ -16,7 +16,7 @@ namespace hairbench::kernels {
 inline constexpr int kMassesPerSegment = 1 + kEnvelopePerSection;
 
 // Those masses coordinate by coordinate, padded to a vector's width with copies of the
-// first: the cheap bounds of SegmentVolume::contains run on all of them at once.
+// first: the volume tests (wisp_grid_kernel.cpp) run on all of them at once.
 struct SegmentMasses {
   static constexpr int kWidth = 8;
   alignas(32) float x[kWidth], y[kWidth], z[kWidth];

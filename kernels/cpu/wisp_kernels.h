@@ -217,7 +217,7 @@ struct WispContact {
 // and normal to t (t_orth where that vanishes), e2 = t x e1, alpha = lateral.e1, beta =
 // lateral.e2, and ra, rb the radii of the envelope masses on the sides of alpha and beta
 // interpolated at u: (alpha/ra)^2 + (beta/rb)^2 < 1. The axis is set up once per
-// detection for the tests of many points (issue 10; the test: wisp_grid.cpp).
+// detection for the tests of many points (issue 10; the test: wisp_grid_kernel.cpp).
 struct SegmentVolume {
   std::uint32_t a = 0;
   Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
