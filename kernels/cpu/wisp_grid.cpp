@@ -1,9 +1,21 @@
 #include "kernels/cpu/wisp_grid.h"
 
+#include "kernels/cpu/wisp_soa.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace hairbench::kernels {
+
+namespace {
+
+void set_mass(SegmentMasses& m, int q, const Vec3f& p) {
+  m.x[q] = p.x();
+  m.y[q] = p.y();
+  m.z[q] = p.z();
+}
+
+}  // namespace
 
 void grid_build(SegmentGrid& g, const WispSystem& s) {
   g.seg.clear();
@@ -15,6 +27,10 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
     for (std::uint32_t k = first > b ? first - 1 : b; k + 1 < e; ++k) g.seg.push_back(k);
   }
   const std::size_t n = g.seg.size();
+  g.wisp.resize(n);
+  g.vol.resize(n);
+  g.mass.resize(n);
+  g.mass_free.resize(n);
   g.lo.resize(n);
   g.hi.resize(n);
   g.cell_lo.resize(n);
@@ -36,8 +52,14 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
         const Vec3f p = envelope_point(s, k, q);
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
+        if (k > g.seg[i]) set_mass(g.mass[i], 1 + q, p);
       }
     }
+    const std::uint32_t k = g.seg[i] + 1;
+    g.wisp[i] = s.node_wisp[k];
+    g.vol[i] = SegmentVolume(s, g.seg[i]);
+    for (int q : {0, kMassesPerSegment, kMassesPerSegment + 1, kMassesPerSegment + 2}) set_mass(g.mass[i], q, s.x[k]);
+    g.mass_free[i] = !s.pinned[k];
     g.lo[i] = lo;
     g.hi[i] = hi;
     all_lo = all_lo.cwiseMin(lo);
@@ -65,36 +87,29 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
         for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) ++g.cell_start[index(x, y, z) + 1];
   }
   for (std::size_t c = 0; c < cells; ++c) g.cell_start[c + 1] += g.cell_start[c];
-  g.cell_items.resize(g.cell_start[cells]);
-  std::vector<std::uint32_t> fill(g.cell_start.begin(), g.cell_start.end() - 1);
+  const std::size_t items = g.cell_start[cells];
+  g.cell_items.resize(items);
+  for (int a = 0; a < 3; ++a) {
+    g.item_lo[a].resize(items);
+    g.item_hi[a].resize(items);
+  }
+  g.cell_fill.assign(g.cell_start.begin(), g.cell_start.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x)
-          g.cell_items[fill[index(x, y, z)]++] = static_cast<std::uint32_t>(i);
+        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+          const std::uint32_t it = g.cell_fill[index(x, y, z)]++;
+          g.cell_items[it] = static_cast<std::uint32_t>(i);
+          for (int a = 0; a < 3; ++a) {
+            g.item_lo[a][it] = g.lo[i][a];
+            g.item_hi[a][it] = g.hi[i][a];
+          }
+        }
 }
 
 void grid_contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                    std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
-  auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
-  for (std::size_t i = begin; i < end; ++i) {
-    const std::uint32_t a = g.seg[i];
-    const std::uint32_t wa = s.node_wisp[a];
-    for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
-      for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::size_t c = index(x, y, z);
-          for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it) {
-            const std::uint32_t j = g.cell_items[it];
-            if (j <= i || mailbox[j] == i) continue;
-            mailbox[j] = static_cast<std::uint32_t>(i);
-            const std::uint32_t b = g.seg[j];
-            if (s.node_wisp[b] == wa && b - a < 3) continue;  // b > a within a wisp
-            if ((g.lo[i].array() > g.hi[j].array()).any() || (g.lo[j].array() > g.hi[i].array()).any()) continue;
-            segment_pair_contacts(s, a, b, out);
-          }
-        }
-  }
+  wisp_soa::kernels().contacts(g, s, begin, end, mailbox, out);
 }
 
 }  // namespace hairbench::kernels

@@ -5,21 +5,45 @@
 
 #include "kernels/cpu/wisp_kernels.h"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 namespace hairbench::kernels {
 
+// The masses a segment (k-1, k) owns: node k and its envelope masses 4k..4k+3, in the
+// order they are tested (§4.1).
+inline constexpr int kMassesPerSegment = 1 + kEnvelopePerSection;
+
+// Those masses coordinate by coordinate, padded to a vector's width with copies of the
+// first: the volume tests (wisp_grid_kernel.cpp) run on all of them at once.
+struct SegmentMasses {
+  static constexpr int kWidth = 8;
+  alignas(32) float x[kWidth], y[kWidth], z[kWidth];
+  Vec3f operator[](int q) const { return {x[q], y[q], z[q]}; }
+};
+
 struct SegmentGrid {
   // Segments that take part: (seg[i], seg[i] + 1), from each wisp's first free node on
   // (the pinned first segment is inside the head, §3.2).
   std::vector<std::uint32_t> seg;
+  std::vector<std::uint32_t> wisp;                 // wisp of segment i
   std::vector<Vec3f> lo, hi;                       // bounding box of skeleton + envelope masses
   std::vector<Eigen::Vector3i> cell_lo, cell_hi;   // cells each box covers
+  // Per segment, set up once per detection for its tests against every other one
+  // (issue 10): its volume, the positions of the masses it owns, and whether they are
+  // free (node seg[i] + 1 is not pinned).
+  std::vector<SegmentVolume> vol;
+  std::vector<SegmentMasses> mass;
+  std::vector<std::uint8_t> mass_free;
   Vec3f origin = Vec3f::Zero();
   float cell = 1.0f;
   Eigen::Vector3i dims = Eigen::Vector3i::Ones();
   std::vector<std::uint32_t> cell_start, cell_items;  // CSR: segments per cell, ascending
+  // The bounding box of each entry of cell_items, coordinate by coordinate, so that a
+  // cell's candidates are tested in one sequential sweep.
+  std::array<std::vector<float>, 3> item_lo, item_hi;
+  std::vector<std::uint32_t> cell_fill;  // scratch of grid_build
 
   std::size_t size() const { return seg.size(); }
 };
@@ -32,7 +56,8 @@ inline constexpr int kMaxGridCells = 64;
 void grid_build(SegmentGrid& g, const WispSystem& s);
 
 // Narrow phase for segments [begin, end) against every later segment sharing a cell
-// with it: bounding boxes, then segment_pair_contacts. Segments of one wisp closer than
+// with it: bounding boxes, then the masses of each segment (node seg+1 and its
+// envelope) tested against the other's volume (§4.1). Segments of one wisp closer than
 // three apart along it are never a pair (neighbours touch by construction). `mailbox`
 // holds one entry per segment, all != any index in [begin, end) on entry. The contacts
 // come in a fixed order (segment, then cell, then segment index), so splitting the range

@@ -55,6 +55,7 @@ void WispSystem::resize_state() {
   racc.assign(kEnvelopePerSection * n, 0.0f);
   node_body.assign(n, -1);
   env_body.assign(kEnvelopePerSection * n, -1);
+  wisp_touches.assign(wisp_count(), 0);
   seg_len.assign(n, 0.0f);
   seg_t.assign(n, Vec3f::Zero());
   node_dv.assign(n, Vec3f::Zero());
@@ -422,6 +423,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
   // than its rest length, so that the reaction carries the rest of the wisp along
   // instead of tearing the spring (it may then be found inside, and moved in turn).
   bool prev_moved = false, any_moved = false;
+  std::uint8_t touches = 0;
   for (std::uint32_t k = b; k < e; ++k) {
     s.node_body[k] = -1;
     if (s.pinned[k]) {
@@ -441,6 +443,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
     const int i = nearest_sphere(body.spheres, s.x[k], gap);
     if (i >= 0 && gap < threshold) {
       s.node_body[k] = i;
+      touches = 1;
       if (gap < 0.0f) {
         const Vec3f c = body.spheres[i].head<3>();
         s.x[k] = push_out(c, body.spheres[i].w() + 0.9f * threshold, s.x[k > b ? k - 1 : k], s.x[k], s.rest_len[k]);
@@ -467,6 +470,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       const int i = nearest_sphere(body.spheres, s.x[k] + s.r[ei] * dir, gap);
       if (i < 0 || gap >= threshold) continue;
       s.env_body[ei] = i;
+      touches = 1;
       if (gap >= 0.0f) continue;
       // Entry point of the half-line x + t dir into the sphere: |x + t dir - c| = R.
       const Vec3f c = body.spheres[i].head<3>();
@@ -489,9 +493,11 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
       if (vn < 0.0f) s.rdot[ei] -= vn * nrm.dot(dir);
     }
   }
+  s.wisp_touches[w] = touches;
 }
 
 void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body) {
+  if (!s.wisp_touches[w]) return;
   for (std::uint32_t k = s.node_begin[w]; k < s.node_begin[w + 1]; ++k) {
     if (s.pinned[k]) continue;
     for (int q = 0; q < kEnvelopePerSection; ++q) {
@@ -507,6 +513,7 @@ void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body) {
 }
 
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag) {
+  if (!s.wisp_touches[w]) return;
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   // The velocity change that removes the approach and damps the tangential slip of a
   // point moving at v at p against sphere i.
@@ -536,79 +543,22 @@ void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float d
 
 namespace {
 
-// Segment (a, a+1)'s axis, set up once for the tests of several points (issue 10): the
-// same operations as one test, in the same order.
-struct SegmentVolume {
-  const WispSystem& s;
-  std::uint32_t a;
-  Vec3f xa, d, t;
-  float len2;
-
-  SegmentVolume(const WispSystem& sys, std::uint32_t seg) : s(sys), a(seg), xa(sys.x[seg]), d(sys.x[seg + 1] - xa) {
-    len2 = d.squaredNorm();
-    if (len2 > 0.0f) t = d / std::sqrt(len2);
-  }
-
-  float contains(const Vec3f& p) const {
-    if (!(len2 > 0.0f)) return -1.0f;
-    const float u = (p - xa).dot(d) / len2;
-    if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
-    const Vec3f lateral = p - (xa + u * d);
-    // The section axes interpolated along the segment, made orthonormal about its axis.
-    Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
-    e1 = unit_or(e1 - e1.dot(t) * t, t.unitOrthogonal());
-    const Vec3f e2 = t.cross(e1);
-    const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
-    const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
-    const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
-    const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u);
-    const float rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
-    const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
-    return f < 1.0f ? u : -1.0f;
-  }
-};
-
-}  // namespace
-
-float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p) { return SegmentVolume(s, a).contains(p); }
-
-namespace {
-
-// The masses of segment (a, a+1) - node a+1 and its envelope - tested against the
-// volume of segment b.
-// Widest envelope radius of node k.
+// Widest envelope radius of node k: its envelope masses lie within it of x[k].
 float widest_radius(const WispSystem& s, std::uint32_t k) {
   const float* r = &s.r[kEnvelopePerSection * k];
   return std::max(std::max(r[0], r[1]), std::max(r[2], r[3]));
 }
 
-void masses_in(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vector<WispContact>& out) {
-  const std::uint32_t k = a + 1;
-  if (s.pinned[k]) return;
-  // Node k's masses lie within its widest radius of x[k], and segment b's volume within
-  // its widest radius of b's axis (segment_contains: |lateral| is at most the radius
-  // interpolated there): where the two balls around them cannot meet, none of the five
-  // masses is inside and their tests are skipped. The margin is far above rounding, so
-  // no mass the full test finds is skipped (issue 10).
-  const SegmentVolume vol(s, b);
-  if (vol.len2 > 0.0f) {
-    const float u = std::clamp((s.x[k] - vol.xa).dot(vol.d) / vol.len2, 0.0f, 1.0f);
-    const float reach = 1.01f * (widest_radius(s, k) + std::max(widest_radius(s, b), widest_radius(s, b + 1)));
-    if ((s.x[k] - (vol.xa + u * vol.d)).squaredNorm() > reach * reach) return;
-  }
-  float u = vol.contains(s.x[k]);
-  if (u >= 0.0f) out.push_back({k, b, u, 0});
-  for (int q = 0; q < kEnvelopePerSection; ++q) {
-    u = vol.contains(envelope_point(s, k, q));
-    if (u >= 0.0f) out.push_back({static_cast<std::uint32_t>(kEnvelopePerSection * k + q), b, u, 1});
-  }
-}
-
 }  // namespace
 
-void segment_pair_contacts(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vector<WispContact>& out) {
-  masses_in(s, a, b, out);
-  masses_in(s, b, a, out);
+SegmentVolume::SegmentVolume(const WispSystem& s, std::uint32_t seg) : a(seg), xa(s.x[seg]), d(s.x[seg + 1] - xa) {
+  len2 = d.squaredNorm();
+  if (len2 > 0.0f) {
+    t = d / std::sqrt(len2);
+    t_orth = t.unitOrthogonal();
+  }
+  const float reach = 1.01f * std::max(widest_radius(s, seg), widest_radius(s, seg + 1));
+  reach2 = reach * reach;
 }
 
 void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,

@@ -71,6 +71,9 @@ struct WispSystem {
 
   // Body contacts found at the last body-collision detection (sphere index, -1 none).
   std::vector<std::int32_t> node_body, env_body;
+  // Per wisp, whether that detection recorded any: the others' sliding contacts and
+  // holds have nothing to do (issue 10).
+  std::vector<std::uint8_t> wisp_touches;
   // Scratch of wisp_forces_and_velocities: length and direction of segment (k-1, k) at k.
   std::vector<float> seg_len;
   std::vector<Vec3f> seg_t;
@@ -207,15 +210,28 @@ struct WispContact {
   std::uint8_t envelope;
 };
 
-// Is p inside the volume of segment (a, a+1), bounded by its two sections? Returns u in
-// [0,1] when inside, a negative value otherwise. The volume is swept by the sections'
-// quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along the axis.
-float segment_contains(const WispSystem& s, std::uint32_t a, const Vec3f& p);
+// The volume of segment (a, a+1), bounded by its two sections (§4.1): swept by the
+// sections' quarter-ellipses (semi-axes: the envelope radii) interpolated linearly along
+// the axis. A point p is inside at axial parameter u = (p - xa).d / |d|^2 in [0,1] when,
+// with lateral = p - (xa + u d), e1 the section axes (1-u) e1[a] + u e1[a+1] made unit
+// and normal to t (t_orth where that vanishes), e2 = t x e1, alpha = lateral.e1, beta =
+// lateral.e2, and ra, rb the radii of the envelope masses on the sides of alpha and beta
+// interpolated at u: (alpha/ra)^2 + (beta/rb)^2 < 1. The axis is set up once per
+// detection for the tests of many points (issue 10; the test: wisp_grid_kernel.cpp).
+struct SegmentVolume {
+  std::uint32_t a = 0;
+  Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
+  float len2 = 0.0f;
+  // (1.01 widest)^2, widest the widest envelope radius at either end. alpha^2 + beta^2
+  // is the squared distance to the axis (e1, e2 an orthonormal basis of the plane normal
+  // to it) and the interpolated radii are at most `widest`: a point farther than that
+  // from the axis is outside. The 1% margin is far above rounding, so a test on this
+  // bound rejects no inside point.
+  float reach2 = 0.0f;
 
-// Narrow phase for one pair of segments whose bounding boxes overlap: the masses of each
-// segment tested against the other's volume (§4.1); appends contacts to out. A segment
-// (k-1, k) owns the masses of node k, so every free mass belongs to exactly one segment.
-void segment_pair_contacts(const WispSystem& s, std::uint32_t a, std::uint32_t b, std::vector<WispContact>& out);
+  SegmentVolume() = default;
+  SegmentVolume(const WispSystem& s, std::uint32_t seg);
+};
 
 // The response of every contact from the current state (§4.1), accumulated then applied
 // as averages per mass: quasi-parallel wisps (orientations within acos(parallel_cos),

@@ -10,6 +10,10 @@
 
 #include "kernels/cpu/wisp_kernels.h"
 
+namespace hairbench::kernels {
+struct SegmentGrid;
+}
+
 namespace hairbench::kernels::wisp_soa {
 
 inline constexpr int kLanes = 16;
@@ -20,16 +24,23 @@ inline constexpr int kMaxNodes = 32;
 // at its tip (the tip's bending spring to the head stays with wisp_forces_and_velocities).
 bool block_eligible(const WispSystem& s, std::size_t w);
 
-// The kLanes wisps `wisps` (each block_eligible, all of one node count and one params
-// set): wisp_forces_and_velocities for each (after wisp_pin).
-using VelocitiesFn = void (*)(WispSystem& s, const std::uint32_t* wisps, const WispParams& p,
+// The `count` wisps `wisps` (1 <= count <= kLanes; each block_eligible, all of one node
+// count and one params set): wisp_forces_and_velocities for each (after wisp_pin). A
+// block of fewer than kLanes wisps repeats its first in the other lanes, whose results
+// are dropped.
+using VelocitiesFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int count, const WispParams& p,
                               const Eigen::Matrix3f& head_rot, const Vec3f& gravity, const Wind& wind, float h);
 // wisp_positions for each, root_e1[l] the head-attached first axis of wisps[l].
-using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, float h);
+using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f* root_e1, float h);
+
+// grid_contacts (wisp_grid.h).
+using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
+                            std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
 
 struct Kernels {
   VelocitiesFn velocities;
   PositionsFn positions;
+  ContactsFn contacts;
 };
 
 // The variant for this CPU.

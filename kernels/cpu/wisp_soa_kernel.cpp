@@ -61,26 +61,30 @@ struct V3 {
   }
 };
 
-// Copies a block's wisps into lanes and back. Only the lanes whose result is valid are
-// written back; the others are left to the per-wisp kernels.
+// Copies a block's wisps into lanes and back. Only the lanes of the block's `count`
+// wisps whose result is valid are written back; the others are left to the per-wisp
+// kernels. Lanes past `count` repeat the first wisp (real data, so that they take the
+// common branches) and are never written back.
 struct Block {
-  int n = 0;
+  int n = 0, count = 0;
   std::uint32_t base[W];
   int bad[W];
 
-  Block(const WispSystem& s, const std::uint32_t* wisps) {
+  Block(const WispSystem& s, const std::uint32_t* wisps, int used) : count(used) {
     n = static_cast<int>(s.node_begin[wisps[0] + 1] - s.node_begin[wisps[0]]);
     for (int l = 0; l < W; ++l) {
-      base[l] = s.node_begin[wisps[l]];
+      base[l] = s.node_begin[wisps[lane(l)]];
       bad[l] = 0;
     }
   }
+  // The wisp (index into the block's wisps) lane l computes.
+  int lane(int l) const { return l < count ? l : 0; }
   void load(V3* dst, const std::vector<Vec3f>& src) const {
     for (int i = 0; i < n; ++i)
       for (int l = 0; l < W; ++l) dst[i].set(l, {src[base[l] + i].x(), src[base[l] + i].y(), src[base[l] + i].z()});
   }
   void store(std::vector<Vec3f>& dst, const V3* src, const float* free = nullptr) const {
-    for (int l = 0; l < W; ++l) {
+    for (int l = 0; l < count; ++l) {
       if (bad[l]) continue;
       for (int i = 0; i < n; ++i)
         if (!free || free[i * W + l] != 0.0f) dst[base[l] + i] = Vec3f(src[i].x[l], src[i].y[l], src[i].z[l]);
@@ -93,7 +97,7 @@ struct Block {
         for (int l = 0; l < W; ++l) dst[(i * per_node + q) * W + l] = static_cast<float>(src[(base[l] + i) * per_node + q]);
   }
   void store(std::vector<float>& dst, const float* src, int per_node) const {
-    for (int l = 0; l < W; ++l) {
+    for (int l = 0; l < count; ++l) {
       if (bad[l]) continue;
       for (int i = 0; i < n; ++i)
         for (int q = 0; q < per_node; ++q) dst[(base[l] + i) * per_node + q] = src[(i * per_node + q) * W + l];
@@ -102,9 +106,9 @@ struct Block {
 };
 
 // wisp_forces_and_velocities for a block (see there for the physics, §3.2, §3.3, §5.1).
-void velocities(WispSystem& s, const std::uint32_t* wisps, const WispParams& p, const Eigen::Matrix3f& head_rot,
-                const Vec3f& gravity, const Wind& wind, float h) {
-  Block blk(s, wisps);
+void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const WispParams& p,
+                const Eigen::Matrix3f& head_rot, const Vec3f& gravity, const Wind& wind, float h) {
+  Block blk(s, wisps, count);
   const int n = blk.n;
   V3 x[N], v[N], e1[N], e2[N], nn[N], bl[N], acc[N], seg_t[N];
   float rest_len[N * W], free[N * W], r_rest[N * W], seg_len[N * W];
@@ -243,28 +247,31 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, const WispParams& p, 
   }
   blk.store(s.v, v, free);
   blk.store(s.rdot, rdot, Q);
-  for (int l = 0; l < W; ++l)
+  for (int l = 0; l < count; ++l)
     if (bad[l]) wisp_forces_and_velocities(s, wisps[l], p, head_rot, gravity, wind, h);
 }
 
 // wisp_positions (and wisp_frames) for a block (§3.3, §5.1 step 4).
-void positions(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, float h) {
-  Block blk(s, wisps);
+void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f* root_e1, float h) {
+  Block blk(s, wisps, count);
   const int n = blk.n;
-  V3 x[N], v[N], e1[N], e2[N], nn[N];
-  float free[N * W], r_rest[N * W], r[N * Q * W], rdot[N * Q * W];
-  blk.load(x, s.x);
+  // The new positions and radii go to arrays of their own: a lane-wise choice written back
+  // over its input compiles to a masked store, which the loads after it cannot be
+  // forwarded from (issue 10).
+  V3 x_old[N], x[N], v[N], e1[N], e2[N], nn[N];
+  float free[N * W], r_rest[N * W], r_old[N * Q * W], rdot_old[N * Q * W], r[N * Q * W], rdot[N * Q * W];
+  blk.load(x_old, s.x);
   blk.load(v, s.v);
   blk.load(free, s.pinned, 1);
   for (float& f : free) f = f == 0.0f ? 1.0f : 0.0f;
   blk.load(r_rest, s.r_rest, 1);
-  blk.load(r, s.r, Q);
-  blk.load(rdot, s.rdot, Q);
+  blk.load(r_old, s.r, Q);
+  blk.load(rdot_old, s.rdot, Q);
   int* bad = blk.bad;
 
   for (int i = 0; i < n; ++i) {
     LANES {
-      const F3 xi = x[i].get(l);
+      const F3 xi = x_old[i].get(l);
       x[i].set(l, pick(free[i * W + l] != 0.0f, add(xi, mul(h, v[i].get(l))), xi));
     }
   }
@@ -285,7 +292,8 @@ void positions(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, 
   }
   LANES {
     nn[n - 1].set(l, prev_t.get(l));
-    const F3 re{root_e1[l].x(), root_e1[l].y(), root_e1[l].z()};
+    const Vec3f& root = root_e1[blk.lane(l)];
+    const F3 re{root.x(), root.y(), root.z()};
     const F3 n0 = nn[0].get(l);
     const F3 first = unit(sub(re, mul(dot(re, n0), n0)), bad[l]);
     e1[0].set(l, first);
@@ -306,8 +314,8 @@ void positions(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, 
       const bool is_free = free[i * W + l] != 0.0f;
       const float r_min = 0.25f * r_rest[i * W + l], r_max = 2.0f * r_rest[i * W + l];
       EACH_Q {
-        const float ri = r[(i * Q + q) * W + l];
-        const float rd = rdot[(i * Q + q) * W + l];
+        const float ri = r_old[(i * Q + q) * W + l];
+        const float rd = rdot_old[(i * Q + q) * W + l];
         const float moved = ri + h * rd;
         const bool low = moved < r_min, high = moved > r_max;
         const float rd_low = rd < 0.0f ? 0.0f : rd, rd_high = 0.0f < rd ? 0.0f : rd;
@@ -325,12 +333,16 @@ void positions(WispSystem& s, const std::uint32_t* wisps, const Vec3f* root_e1, 
   blk.store(s.e2, e2);
   blk.store(s.r, r, Q);
   blk.store(s.rdot, rdot, Q);
-  for (int l = 0; l < W; ++l)
+  for (int l = 0; l < count; ++l)
     if (bad[l]) wisp_positions(s, wisps[l], root_e1[l], h);
 }
 
 }  // namespace
 
-Kernels kernels() { return {velocities, positions}; }
+// wisp_grid_kernel.cpp
+void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
+              std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+
+Kernels kernels() { return {velocities, positions, contacts}; }
 
 }  // namespace hairbench::kernels::wisp_soa::PLANTE_SOA_VARIANT

@@ -218,9 +218,11 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   for (float& r : sys_.r_rest) r = std::max(r, r_min);
   for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
   // Blocks of the fused schedule: consecutive wisps of one node count and params set
-  // (k-means clusters of one region and strand size are consecutive, cluster()).
+  // (k-means clusters of one region and strand size are consecutive, cluster()). A block
+  // costs about as much as 7 wisps through the per-wisp kernels whatever its lanes in
+  // use (issue 10: 2.3 times faster for 16), so it takes runs of at least half its lanes.
   runs_.clear();
-  constexpr std::uint32_t lanes = k::wisp_soa::kLanes;
+  constexpr std::uint32_t lanes = k::wisp_soa::kLanes, kMinBlockLanes = lanes / 2;
   const auto wisps = static_cast<std::uint32_t>(sys_.wisp_count());
   auto size = [&](std::uint32_t w) { return sys_.node_begin[w + 1] - sys_.node_begin[w]; };
   for (std::uint32_t w = 0; w < wisps;) {
@@ -228,7 +230,7 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
     while (n < lanes && w + n < wisps && k::wisp_soa::block_eligible(sys_, w + n) && size(w + n) == size(w) &&
            sys_.wisp_params[w + n] == sys_.wisp_params[w])
       ++n;
-    if (n < lanes) n = 1;
+    if (n < kMinBlockLanes) n = 1;
     runs_.push_back({w, n});
     w += n;
   }
@@ -391,7 +393,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       } else {
         std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
         for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
-        block_.velocities(sys_, ids.data(), p, head_rot, in.gravity, in.wind, h);
+        block_.velocities(sys_, ids.data(), static_cast<int>(run.count), p, head_rot, in.gravity, in.wind, h);
       }
       clock.lap(kIntegration);
       if (body_on) {
@@ -407,7 +409,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       } else {
         std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
         for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
-        block_.positions(sys_, ids.data(), root_e1.data(), h);
+        block_.positions(sys_, ids.data(), static_cast<int>(run.count), root_e1.data(), h);
       }
       clock.lap(kIntegration);
       if (body_on) {

@@ -85,7 +85,7 @@ class PlanteWispModel final : public HairModel {
   StrandSleep sleep_;
 
   kernels::WispSystem sys_;
-  // The fused schedule's units of work, in wisp order: blocks of wisp_soa::kLanes
+  // The fused schedule's units of work, in wisp order: blocks of up to wisp_soa::kLanes
   // consecutive wisps that the block kernels take together (one node count and one
   // params set each), and single wisps.
   struct WispRun {
