@@ -1,5 +1,6 @@
 // Properties Plante, Cani & Poulin 2001 claims for the layered wisp model (§3-§5),
 // checked on hand-built wisp pairs and on the built-in scenarios.
+#include "kernels/cpu/wisp_soa.h"
 #include "models/plante_wisp/model.h"
 #include "models/plante_wisp/settings.h"
 #include "reports/metrics.h"
@@ -360,6 +361,28 @@ TEST(PlanteWisp, FastAgreesBitForBitWithTheReference) {
   for (std::size_t f = 0; f < fast.deviation.size(); ++f) ASSERT_EQ(fast.deviation[f], slow.deviation[f]) << "frame " << f;
   const auto one = test::run(sc, {"plante_wisp"}, parallel, 1);
   EXPECT_EQ(one[0].state_hash, slow.state_hash);
+}
+
+// The baseline and x86-64-v4 builds of the block and narrow-phase kernels give the same
+// bits (FMA contraction off; every lane performs the per-wisp kernels' operations).
+TEST(PlanteWisp, IsaVariantsGiveTheSameBits) {
+  const Scenario sc = builtin("shake", 8);
+  const ParamSet params = plante_params(sc.groom);
+  plante::PlanteWispModel best(ModelContext{nullptr}), base(ModelContext{nullptr});
+  base.use_kernels(kernels::wisp_soa::kernels_baseline());
+  best.reset(sc.groom, params);
+  base.reset(sc.groom, params);
+  ASSERT_GT(best.block_wisps(), 0u) << "no wisp runs in a block: the test would not reach the block kernels";
+  std::size_t contacts = 0;
+  for (int f = 0; f < 30; ++f) {
+    StageTimes t;
+    best.step(frame_input(sc, f), t);
+    base.step(frame_input(sc, f), t);
+    contacts += best.contacts().size();
+  }
+  EXPECT_GT(contacts, 0u) << "no wisp-wisp contact: the narrow phase found nothing to compare";
+  EXPECT_EQ(metrics::state_hash(best.positions()), metrics::state_hash(base.positions()))
+      << kernels::wisp_soa::kernels_isa();
 }
 
 }  // namespace

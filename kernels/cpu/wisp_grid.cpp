@@ -107,9 +107,4 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
         }
 }
 
-void grid_contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
-                   std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
-  wisp_soa::kernels().contacts(g, s, begin, end, mailbox, out);
-}
-
 }  // namespace hairbench::kernels

@@ -1,4 +1,4 @@
-// The narrow phase of the wisp-wisp interactions (wisp_grid.h, grid_contacts), compiled
+// The narrow phase of the wisp-wisp interactions (wisp_soa.h, ContactsFn), compiled
 // once per ISA variant like the block kernels (kernels/CMakeLists.txt): the box tests
 // of a cell's candidates and the volume tests of a segment's masses run as vector code.
 #include "kernels/cpu/wisp_grid.h"

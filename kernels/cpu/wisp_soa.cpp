@@ -38,6 +38,8 @@ Kernels kernels() {
 #endif
 }
 
+Kernels kernels_baseline() { return baseline::kernels(); }
+
 const char* kernels_isa() { return has_v4() ? "x86-64-v4" : "baseline"; }
 
 }  // namespace hairbench::kernels::wisp_soa

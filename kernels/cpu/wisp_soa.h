@@ -33,7 +33,14 @@ using VelocitiesFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int cou
 // wisp_positions for each, root_e1[l] the head-attached first axis of wisps[l].
 using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f* root_e1, float h);
 
-// grid_contacts (wisp_grid.h).
+// The narrow phase of the wisp-wisp interactions on a SegmentGrid (wisp_grid.h):
+// segments [begin, end) against every later segment sharing a cell with it: bounding
+// boxes, then the masses of each segment (node seg+1 and its envelope) tested against
+// the other's volume (§4.1). Segments of one wisp closer than
+// three apart along it are never a pair (neighbours touch by construction). `mailbox`
+// holds one entry per segment, all != any index in [begin, end) on entry. The contacts
+// come in a fixed order (segment, then cell, then segment index), so splitting the range
+// across threads and concatenating the outputs in range order gives the serial list.
 using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                             std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
 
@@ -46,5 +53,7 @@ struct Kernels {
 // The variant for this CPU.
 Kernels kernels();
 const char* kernels_isa();
+// The baseline variant, for the tests that compare ISA variants.
+Kernels kernels_baseline();
 
 }  // namespace hairbench::kernels::wisp_soa

@@ -302,6 +302,12 @@ std::size_t PlanteWispModel::state_bytes() const {
          bytes(sys_.r) + bytes(sys_.rdot) + bytes(sys_.racc) + bytes(pos_);
 }
 
+std::size_t PlanteWispModel::block_wisps() const {
+  std::size_t n = 0;
+  for (const WispRun& run : runs_) n += run.count > 1 ? run.count : 0;
+  return n;
+}
+
 void PlanteWispModel::detect_self_interactions() {
   k::grid_build(grid_, sys_);
   const std::size_t n = grid_.size(), chunks = chunk_contacts_.size();
@@ -309,7 +315,7 @@ void PlanteWispModel::detect_self_interactions() {
     for (std::size_t c = cb; c < ce; ++c) {
       chunk_contacts_[c].clear();
       chunk_mailbox_[c].assign(n, std::numeric_limits<std::uint32_t>::max());
-      k::grid_contacts(grid_, sys_, n * c / chunks, n * (c + 1) / chunks, chunk_mailbox_[c], chunk_contacts_[c]);
+      block_.contacts(grid_, sys_, n * c / chunks, n * (c + 1) / chunks, chunk_mailbox_[c], chunk_contacts_[c]);
     }
   };
   if (ctx_.pool && chunks > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))

@@ -50,6 +50,10 @@ class PlanteWispModel final : public HairModel {
   void rebuild(const Affine3f& head);
   // Contacts of the last wisp-wisp detection.
   std::span<const kernels::WispContact> contacts() const { return contacts_; }
+  // The block and narrow-phase kernels' ISA variant (by default this CPU's best), for the
+  // tests that compare variants; and how many wisps the block kernels take.
+  void use_kernels(const kernels::wisp_soa::Kernels& k) { block_ = k; }
+  std::size_t block_wisps() const;
 
  private:
   void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max);
@@ -92,7 +96,7 @@ class PlanteWispModel final : public HairModel {
     std::uint32_t first, count;
   };
   std::vector<WispRun> runs_;
-  kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();
+  kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();  // and the narrow phase
   std::vector<std::uint32_t> strand_wisp_;
   std::vector<Vec4f> coord_;  // per groom vertex
   std::vector<Vec4f> pos_;
