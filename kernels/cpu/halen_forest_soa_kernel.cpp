@@ -3,7 +3,7 @@
 // halen_soa_kernel.cpp.
 #include "kernels/cpu/halen_soa.h"
 #include "kernels/cpu/soa_common.h"
-#include "kernels/cpu/soa_write_back.h"
+#include "kernels/cpu/soa_rows.h"
 #include "kernels/cpu/vec_math.h"
 
 #include <cmath>
@@ -17,6 +17,7 @@ namespace hairbench::kernels::halen_soa::HALEN_SOA_VARIANT {
 namespace {
 
 constexpr int W = kLanes;
+static_assert(W == soa::kRowLanes, "soa_rows.h takes rows of 16 lanes");
 
 #define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
 

@@ -4,7 +4,7 @@
 // instructions of that variant.
 #include "kernels/cpu/halen_soa.h"
 #include "kernels/cpu/soa_common.h"
-#include "kernels/cpu/soa_write_back.h"
+#include "kernels/cpu/soa_rows.h"
 
 #include <cmath>
 #include <cstdint>
@@ -19,6 +19,7 @@ namespace hairbench::kernels::halen_soa::HALEN_SOA_VARIANT {
 namespace {
 
 constexpr int W = kLanes;
+static_assert(W == soa::kRowLanes, "soa_rows.h takes rows of 16 lanes");
 
 #define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
 
@@ -91,16 +92,7 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
   float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
   float *mx = m.x, *my = m.y, *mz = m.z;
   if constexpr (kKind == kRowPinned) {
-    if constexpr (kSpring)
-      LANES {
-        const float x = px[l], y = py[l], z = pz[l];
-        px[l] = h.x(rx[l], ry[l], rz[l]);
-        py[l] = h.y(rx[l], ry[l], rz[l]);
-        pz[l] = h.z(rx[l], ry[l], rz[l]);
-        qx[l] = x;
-        qy[l] = y;
-        qz[l] = z;
-      }
+    if constexpr (kSpring) soa::follow_head_row(h, px, py, pz, qx, qy, qz, rx, ry, rz);
     if constexpr (kWindy)
       LANES {
         mx[l] = px[l];

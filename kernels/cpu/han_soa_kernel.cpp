@@ -4,7 +4,7 @@
 // instructions of that variant.
 #include "kernels/cpu/han_soa.h"
 #include "kernels/cpu/soa_common.h"
-#include "kernels/cpu/soa_write_back.h"
+#include "kernels/cpu/soa_rows.h"
 
 #include <cmath>
 #include <cstring>
@@ -22,6 +22,7 @@ namespace hairbench::kernels::han_soa::HAN_SOA_VARIANT {
 namespace {
 
 constexpr int W = kLanes;
+static_assert(W == soa::kRowLanes, "soa_rows.h takes rows of 16 lanes");
 
 #define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
 
@@ -132,15 +133,7 @@ inline void integrate_row(const Rows& r, int i, const soa::AffinePose& h, const 
   float *px = r.px + o, *py = r.py + o, *pz = r.pz + o, *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
   const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
   if constexpr (kKind == kRowPinned) {
-    LANES {
-      const float x = px[l], y = py[l], z = pz[l];
-      px[l] = h.x(rx[l], ry[l], rz[l]);
-      py[l] = h.y(rx[l], ry[l], rz[l]);
-      pz[l] = h.z(rx[l], ry[l], rz[l]);
-      qx[l] = x;
-      qy[l] = y;
-      qz[l] = z;
-    }
+    soa::follow_head_row(h, px, py, pz, qx, qy, qz, rx, ry, rz);
     return;
   }
   const bool root = i == 0;  // the integrator starts at vertex 1; the root only follows the head

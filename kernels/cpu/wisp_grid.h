@@ -55,5 +55,4 @@ inline constexpr int kMaxGridCells = 64;
 // Rebuilds the grid from the current state.
 void grid_build(SegmentGrid& g, const WispSystem& s);
 
-
 }  // namespace hairbench::kernels

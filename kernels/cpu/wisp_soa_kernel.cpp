@@ -103,6 +103,11 @@ struct Block {
         for (int q = 0; q < per_node; ++q) dst[(base[l] + i) * per_node + q] = src[(i * per_node + q) * W + l];
     }
   }
+  // 1 for a free node, 0 for a pinned one.
+  void load_free(float* dst, const std::vector<std::uint8_t>& pinned) const {
+    load(dst, pinned, 1);
+    for (int k = 0; k < n * W; ++k) dst[k] = dst[k] == 0.0f ? 1.0f : 0.0f;
+  }
 };
 
 // wisp_forces_and_velocities for a block (see there for the physics, §3.2, §3.3, §5.1).
@@ -120,8 +125,7 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   blk.load(nn, s.n);
   blk.load(bl, s.bend_local);
   blk.load(rest_len, s.rest_len, 1);
-  blk.load(free, s.pinned, 1);
-  for (float& f : free) f = f == 0.0f ? 1.0f : 0.0f;
+  blk.load_free(free, s.pinned);
   blk.load(r_rest, s.r_rest, 1);
   blk.load(r, s.r, Q);
   blk.load(rdot, s.rdot, Q);
@@ -262,8 +266,7 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
   float free[N * W], r_rest[N * W], r_old[N * Q * W], rdot_old[N * Q * W], r[N * Q * W], rdot[N * Q * W];
   blk.load(x_old, s.x);
   blk.load(v, s.v);
-  blk.load(free, s.pinned, 1);
-  for (float& f : free) f = f == 0.0f ? 1.0f : 0.0f;
+  blk.load_free(free, s.pinned);
   blk.load(r_rest, s.r_rest, 1);
   blk.load(r_old, s.r, Q);
   blk.load(rdot_old, s.rdot, Q);

@@ -1,8 +1,10 @@
-// The block kernels' (han_soa, halen_soa) last step of a frame: a block's rows back to the
-// groom-ordered float4 array. The kernel files are compiled once per ISA variant, so this
-// has internal linkage: each variant keeps its own code (an inline function with external
+// Row operations shared by the block kernels (han_soa, halen_soa): rows of 16 lanes, one
+// strand per lane. The kernel files are compiled once per ISA variant, so these have
+// internal linkage: each variant keeps its own code (an inline function with external
 // linkage would be merged across the variants by the linker).
 #pragma once
+
+#include "kernels/cpu/soa_common.h"
 
 #include <cstddef>
 
@@ -13,6 +15,26 @@
 namespace hairbench::kernels::soa {
 namespace {
 
+inline constexpr int kRowLanes = 16;
+
+// A pinned row follows the head (follow_head of the per-strand kernels): prev = pos,
+// pos = head · rest, in Eigen's order (AffinePose). The pose is taken by value: through a
+// reference the compiler must assume the row stores may change it, and leaves the lane
+// loop scalar.
+inline void follow_head_row(const AffinePose h, float* __restrict px, float* __restrict py, float* __restrict pz,
+                            float* __restrict qx, float* __restrict qy, float* __restrict qz, const float* rx,
+                            const float* ry, const float* rz) {
+  _Pragma("GCC ivdep") for (int l = 0; l < kRowLanes; ++l) {
+    const float x = px[l], y = py[l], z = pz[l];
+    px[l] = h.x(rx[l], ry[l], rz[l]);
+    py[l] = h.y(rx[l], ry[l], rz[l]);
+    pz[l] = h.z(rx[l], ry[l], rz[l]);
+    qx[l] = x;
+    qy[l] = y;
+    qz[l] = z;
+  }
+}
+
 // Rows 0..n-1 of x, y, z and w (16 lanes each, consecutive rows 16 floats apart) to
 // lane_out[l] + 4 i, float4 per vertex, for every lane whose lane_out[l] is not null. With
 // AVX-512, a transpose of each row's four vectors into one float4 per lane: sixteen 16-byte
@@ -22,11 +44,10 @@ namespace {
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 inline void write_rows_float4(const float* x, const float* y, const float* z, const float* w, int n,
                               float* const* lane_out) {
-  constexpr int kW = 16;
 #if defined(__AVX512F__)
   for (int i = 0; i < n; ++i) {
-    const __m512 vx = _mm512_loadu_ps(x + i * kW), vy = _mm512_loadu_ps(y + i * kW),
-                 vz = _mm512_loadu_ps(z + i * kW), vw = _mm512_loadu_ps(w + i * kW);
+    const __m512 vx = _mm512_loadu_ps(x + i * kRowLanes), vy = _mm512_loadu_ps(y + i * kRowLanes),
+                 vz = _mm512_loadu_ps(z + i * kRowLanes), vw = _mm512_loadu_ps(w + i * kRowLanes);
     const __m512 t0 = _mm512_unpacklo_ps(vx, vy), t1 = _mm512_unpackhi_ps(vx, vy);
     const __m512 t2 = _mm512_unpacklo_ps(vz, vw), t3 = _mm512_unpackhi_ps(vz, vw);
     // v[m] holds lane 4k + m's float4 in its 128-bit part k.
@@ -43,14 +64,14 @@ inline void write_rows_float4(const float* x, const float* y, const float* z, co
     }
   }
 #else
-  for (int l = 0; l < kW; ++l) {
+  for (int l = 0; l < kRowLanes; ++l) {
     float* o = lane_out[l];
     if (!o) continue;
     for (int i = 0; i < n; ++i) {
-      o[4 * i] = x[i * kW + l];
-      o[4 * i + 1] = y[i * kW + l];
-      o[4 * i + 2] = z[i * kW + l];
-      o[4 * i + 3] = w[i * kW + l];
+      o[4 * i] = x[i * kRowLanes + l];
+      o[4 * i + 1] = y[i * kRowLanes + l];
+      o[4 * i + 2] = z[i * kRowLanes + l];
+      o[4 * i + 3] = w[i * kRowLanes + l];
     }
   }
 #endif
