@@ -23,11 +23,44 @@ Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
 // Squared distance between a rest strand and a cluster centre of equal vertex count:
 // the root weighs as much as the rest of the strand together, so wisps stay compact at
 // the scalp, where the strands are pinned and the rebuild cannot bend them apart.
-float strand_distance2(const Groom& g, std::uint32_t s, const std::vector<Vec3f>& centre, std::size_t j, std::size_t n) {
+// The terms are never negative, so the partial sums only grow: once one exceeds `bound`
+// the strand is farther than that, and the sum so far is returned (issue 10).
+float strand_distance2(const Groom& g, std::uint32_t s, const std::vector<Vec3f>& centre, std::size_t j, std::size_t n,
+                       float bound) {
   const std::uint32_t b = g.strand_begin(s);
   float d = static_cast<float>(n) * (xyz(g.positions[b]) - centre[j * n]).squaredNorm();
-  for (std::size_t i = 1; i < n; ++i) d += (xyz(g.positions[b + i]) - centre[j * n + i]).squaredNorm();
+  for (std::size_t i = 1; i < n && !(d > bound); ++i) d += (xyz(g.positions[b + i]) - centre[j * n + i]).squaredNorm();
   return d;
+}
+
+// The nearest centre to strand s: the first of equal distances in centre order, as a
+// scan of all centres in order finds. `by_x` holds the centres sorted by their root's x
+// (root_x ascending): the scan starts at the strand's own root x and walks outwards,
+// and stops on each side where n dx^2 alone (a lower bound of the distance, less a
+// margin far above rounding) exceeds the best found. `guess` (the last round's centre)
+// sets the first bound.
+std::uint32_t nearest_centre(const Groom& g, std::uint32_t s, const std::vector<Vec3f>& centre, std::size_t n,
+                             const std::vector<std::uint32_t>& by_x, const std::vector<float>& root_x,
+                             std::uint32_t guess) {
+  std::uint32_t best_j = guess;
+  float best = strand_distance2(g, s, centre, guess, n, std::numeric_limits<float>::infinity());
+  auto visit = [&](std::uint32_t j) {
+    const float d = strand_distance2(g, s, centre, j, n, best);
+    if (d < best || (d == best && j < best_j)) {
+      best = d;
+      best_j = j;
+    }
+  };
+  const float x = g.positions[g.strand_begin(s)].x();
+  const float weight = 0.999f * static_cast<float>(n);
+  auto far = [&](std::size_t at) {
+    const float dx = root_x[at] - x;
+    return weight * dx * dx > best;
+  };
+  const std::size_t mid = static_cast<std::size_t>(std::lower_bound(root_x.begin(), root_x.end(), x) - root_x.begin());
+  for (std::size_t at = mid; at < by_x.size() && !far(at); ++at) visit(by_x[at]);
+  for (std::size_t at = mid; at-- > 0 && !far(at);) visit(by_x[at]);
+  return best_j;
 }
 
 // k-means with a fixed start (every (size/k)-th strand of the group) and a fixed number
@@ -35,8 +68,10 @@ float strand_distance2(const Groom& g, std::uint32_t s, const std::vector<Vec3f>
 // their rest vertices, not the root alone: near the crown, neighbouring roots comb
 // apart in every direction, and a wisp must hold strands that stay together (§3.1:
 // "neighboring hair strands of similar orientations"). Elsewhere the root dominates.
+// Each strand's nearest centre is found on its own (over the threads, the same labels
+// for any thread count); the centres are then summed in strand order.
 std::vector<std::vector<std::uint32_t>> kmeans_strands(const Groom& g, const std::vector<std::uint32_t>& strands,
-                                                       std::size_t k) {
+                                                       std::size_t k, ThreadPool* pool) {
   const std::size_t count = strands.size();
   const std::size_t n = g.strand_size(strands[0]);
   k = std::clamp<std::size_t>(k, 1, count);
@@ -48,18 +83,23 @@ std::vector<std::vector<std::uint32_t>> kmeans_strands(const Groom& g, const std
   std::vector<std::uint32_t> label(count, 0);
   std::vector<Vec3f> sum(k * n);
   std::vector<int> size(k);
+  std::vector<std::uint32_t> by_x(k);
+  std::vector<float> root_x(k);
+  auto assign = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) label[i] = nearest_centre(g, strands[i], centre, n, by_x, root_x, label[i]);
+  };
   constexpr int kRounds = 12;
+  constexpr std::size_t kThreadsMinStrands = 1024;  // fewer: a hand-off costs more than the work
   for (int round = 0; round < kRounds; ++round) {
-    for (std::size_t i = 0; i < count; ++i) {
-      float best = std::numeric_limits<float>::infinity();
-      for (std::size_t j = 0; j < k; ++j) {
-        const float d = strand_distance2(g, strands[i], centre, j, n);
-        if (d < best) {
-          best = d;
-          label[i] = static_cast<std::uint32_t>(j);
-        }
-      }
-    }
+    for (std::uint32_t j = 0; j < k; ++j) by_x[j] = j;
+    std::sort(by_x.begin(), by_x.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return std::pair{centre[a * n].x(), a} < std::pair{centre[b * n].x(), b};
+    });
+    for (std::size_t at = 0; at < k; ++at) root_x[at] = centre[by_x[at] * n].x();
+    if (pool && count >= kThreadsMinStrands)
+      pool->parallel_for(count, assign);
+    else
+      assign(0, count);
     std::fill(sum.begin(), sum.end(), Vec3f::Zero());
     std::fill(size.begin(), size.end(), 0);
     for (std::size_t i = 0; i < count; ++i) {
@@ -123,13 +163,13 @@ void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp
     // curve) are split in two until none is; the paper's wisps are "mostly as wide as
     // they are long" (§4.1, footnote 1), i.e. r up to half a segment.
     std::vector<std::vector<std::uint32_t>> todo =
-        kmeans_strands(rest, strands, static_cast<std::size_t>(std::max(1.0, std::round(want))));
+        kmeans_strands(rest, strands, static_cast<std::size_t>(std::max(1.0, std::round(want))), ctx_.pool);
     std::vector<std::vector<std::uint32_t>> clusters;
     while (!todo.empty()) {
       std::vector<std::uint32_t> c = std::move(todo.back());
       todo.pop_back();
       auto halves = c.size() > 1 && cluster_width(rest, c) > width_max * cluster_edge(rest, c)
-                        ? kmeans_strands(rest, c, 2)
+                        ? kmeans_strands(rest, c, 2, ctx_.pool)
                         : std::vector<std::vector<std::uint32_t>>{};
       if (halves.size() == 2) {
         for (auto& half : halves) todo.push_back(std::move(half));
