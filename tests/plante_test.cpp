@@ -333,7 +333,8 @@ TEST(PlanteWisp, RebuiltStrandsKeepTheirEdgeLengths) {
 }
 
 // Same input -> bit-identical state on every run and thread count (contacts are found
-// per segment range and concatenated in range order; responses are applied serially).
+// per segment range and concatenated in range order; the responses on each mass are
+// summed in list order, whichever thread owns it).
 TEST(PlanteWisp, DeterministicAcrossRunsAndThreads) {
   const Scenario sc = builtin("shake", 8);
   const std::vector<ParamOverride> parallel = {{"plante_wisp", "threads_min_wisps", 1}};

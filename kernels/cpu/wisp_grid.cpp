@@ -35,6 +35,7 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
   g.hi.resize(n);
   g.cell_lo.resize(n);
   g.cell_hi.resize(n);
+  g.candidates.assign(n, 0);
   if (n == 0) {
     g.cell_start.assign(2, 0);
     g.cell_items.clear();
@@ -105,6 +106,25 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
             g.item_hi[a][it] = g.hi[i][a];
           }
         }
+  // A cell's items ascend (filled in segment order): the one of rank r has the rest after it.
+  for (std::size_t c = 0; c < cells; ++c)
+    for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it)
+      g.candidates[g.cell_items[it]] += g.cell_start[c + 1] - it - 1;
+}
+
+void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t>& bounds) {
+  const std::size_t n = g.size();
+  // Each segment also costs its own cell visits: one candidate's worth.
+  std::uint64_t total = 0;
+  for (std::uint32_t c : g.candidates) total += c + 1;
+  bounds.assign(parts + 1, n);
+  bounds[0] = 0;
+  std::uint64_t done = 0;
+  std::size_t p = 1;
+  for (std::size_t i = 0; i < n && p < parts; ++i) {
+    done += g.candidates[i] + 1;
+    while (p < parts && done * parts >= total * p) bounds[p++] = i + 1;
+  }
 }
 
 }  // namespace hairbench::kernels

@@ -44,6 +44,10 @@ struct SegmentGrid {
   // cell's candidates are tested in one sequential sweep.
   std::array<std::vector<float>, 3> item_lo, item_hi;
   std::vector<std::uint32_t> cell_fill;  // scratch of grid_build
+  // Per segment, its candidates: the later segments in its cells, summed over the cells.
+  // The narrow phase of segment i costs about that much, and it falls the more the later
+  // i is, so equal ranges of segments are far from equal work (issue 10: grid_split).
+  std::vector<std::uint32_t> candidates;
 
   std::size_t size() const { return seg.size(); }
 };
@@ -54,5 +58,9 @@ inline constexpr int kMaxGridCells = 64;
 
 // Rebuilds the grid from the current state.
 void grid_build(SegmentGrid& g, const WispSystem& s);
+
+// Bounds of `parts` contiguous ranges of segments with about equal candidates each:
+// range p is [bounds[p], bounds[p + 1]).
+void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t>& bounds);
 
 }  // namespace hairbench::kernels

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hairbench::kernels {
 
@@ -561,95 +562,123 @@ SegmentVolume::SegmentVolume(const WispSystem& s, std::uint32_t seg) : a(seg), x
   reach2 = reach * reach;
 }
 
-void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,
-                           std::span<const WispParams> params, float h) {
-  for (const WispContact& c : contacts) {
-    const std::uint32_t k = c.envelope ? c.point / kEnvelopePerSection : c.point;
-    if (s.pinned[k]) continue;
-    const int q = static_cast<int>(c.point % kEnvelopePerSection);
-    const Vec3f dir = c.envelope ? envelope_dir(s, k, q) : Vec3f::Zero();
-    const Vec3f p = c.envelope ? Vec3f(s.x[k] + s.r[c.point] * dir) : s.x[k];
-    const Vec3f vp = c.envelope ? Vec3f(s.v[k] + s.rdot[c.point] * dir) : s.v[k];
-    const float mp = c.envelope ? params[s.wisp_params[s.node_wisp[k]]].envelope_mass : 1.0f;
-    const std::uint32_t a = c.seg;
-    const Vec3f axis = s.x[a + 1] - s.x[a];
-    const Vec3f sigma_s = unit_or(axis, s.n[a]);
-    const Vec3f& sigma_p = s.n[k];
-    const Vec3f vs = (1.0f - c.u) * s.v[a] + c.u * s.v[a + 1];
-    const Vec3f rel = vp - vs;
+ContactImpulse contact_impulse(const WispSystem& s, const WispContact& c, const InteractionParams& ip,
+                              std::span<const WispParams> params, float h) {
+  const std::uint32_t k = c.envelope ? c.point / kEnvelopePerSection : c.point;
+  if (s.pinned[k]) return {Vec3f::Zero(), 0.0f, 0.0f, false};
+  const int q = static_cast<int>(c.point % kEnvelopePerSection);
+  const Vec3f dir = c.envelope ? envelope_dir(s, k, q) : Vec3f::Zero();
+  const Vec3f p = c.envelope ? Vec3f(s.x[k] + s.r[c.point] * dir) : s.x[k];
+  const Vec3f vp = c.envelope ? Vec3f(s.v[k] + s.rdot[c.point] * dir) : s.v[k];
+  const float mp = c.envelope ? params[s.wisp_params[s.node_wisp[k]]].envelope_mass : 1.0f;
+  const std::uint32_t a = c.seg;
+  const Vec3f axis = s.x[a + 1] - s.x[a];
+  const Vec3f sigma_s = unit_or(axis, s.n[a]);
+  const Vec3f& sigma_p = s.n[k];
+  const Vec3f vs = (1.0f - c.u) * s.v[a] + c.u * s.v[a + 1];
+  const Vec3f rel = vp - vs;
 
-    // §4.1: quasi-parallel wisps lie in one plane and move roughly within it. Its normal
-    // is sigma_p x sigma_s; for wisps within a few degrees of parallel that product
-    // vanishes, and the plane through the segment's axis and the point (which holds both
-    // wisps) is used instead.
-    Vec3f dv = -rel;  // very dissipative collision by default: contact velocities averaged
-    bool parallel = std::abs(sigma_p.dot(sigma_s)) >= ip.parallel_cos;
+  // §4.1: quasi-parallel wisps lie in one plane and move roughly within it. Its normal
+  // is sigma_p x sigma_s; for wisps within a few degrees of parallel that product
+  // vanishes, and the plane through the segment's axis and the point (which holds both
+  // wisps) is used instead.
+  Vec3f dv = -rel;  // very dissipative collision by default: contact velocities averaged
+  bool parallel = std::abs(sigma_p.dot(sigma_s)) >= ip.parallel_cos;
+  if (parallel) {
+    constexpr float kMinSin = 0.087f;  // sin 5°
+    Vec3f nrm = sigma_p.cross(sigma_s);
+    if (nrm.squaredNorm() < kMinSin * kMinSin) nrm = sigma_s.cross(p - (s.x[a] + c.u * axis));
+    nrm = unit_or(nrm, sigma_s.unitOrthogonal());
+    const float out_of_plane = rel.dot(nrm);
+    parallel = std::abs(out_of_plane) <= ip.in_plane_sin * rel.norm();
     if (parallel) {
-      constexpr float kMinSin = 0.087f;  // sin 5°
-      Vec3f nrm = sigma_p.cross(sigma_s);
-      if (nrm.squaredNorm() < kMinSin * kMinSin) nrm = sigma_s.cross(p - (s.x[a] + c.u * axis));
-      nrm = unit_or(nrm, sigma_s.unitOrthogonal());
-      const float out_of_plane = rel.dot(nrm);
-      parallel = std::abs(out_of_plane) <= ip.in_plane_sin * rel.norm();
-      if (parallel) {
-        // Viscous drag proportional to the strand density of the penetrated segment
-        // (its rest cross-section over the current one) and to the time step.
-        const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
-        auto radius = [&](int qq) { return lerp(s.r[ea + qq], s.r[eb + qq], c.u); };
-        const float r0 = lerp(s.r_rest[a], s.r_rest[a + 1], c.u);
-        const float area = 0.25f * (radius(0) + radius(2)) * (radius(1) + radius(3));
-        const float density = area > 0.0f ? r0 * r0 / area : 1.0f;
-        const float drag = std::min(1.0f, ip.hair_friction * density * h);
-        dv = -out_of_plane * nrm - drag * (rel - out_of_plane * nrm);
-      }
-    }
-
-    // Momentum-conserving split between the point (mass mp) and the segment's skeleton
-    // (unit masses): equal masses give the paper's Delta v_p = -(...)/2.
-    const Vec3f dvp = dv * (1.0f / (1.0f + mp));
-    Vec3f impulse;
-    if (c.envelope) {
-      const float dr = dvp.dot(dir);
-      s.env_dr[c.point] += dr;
-      s.env_dr_weight[c.point] += 1.0f;
-      impulse = mp * dr * dir;
-    } else {
-      s.node_dv[k] += dvp;
-      s.node_dv_weight[k] += 1.0f;
-      impulse = dvp;
-    }
-    // The segment's nodes take the opposite impulse, shared linearly. In the average
-    // over a node's contacts, a contact counts by the share of the relative velocity it
-    // asks the node to absorb (1 for an equal mass, less for a light envelope mass), so
-    // that many light contacts do not dilute a heavy one.
-    const float share = 2.0f * mp / (1.0f + mp);
-    for (const auto& [node, weight] : {std::pair{a, 1.0f - c.u}, std::pair{a + 1, c.u}}) {
-      if (s.pinned[node]) continue;
-      s.node_dv[node] -= weight * impulse;
-      s.node_dv_weight[node] += weight * share;
+      // Viscous drag proportional to the strand density of the penetrated segment
+      // (its rest cross-section over the current one) and to the time step.
+      const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
+      auto radius = [&](int qq) { return lerp(s.r[ea + qq], s.r[eb + qq], c.u); };
+      const float r0 = lerp(s.r_rest[a], s.r_rest[a + 1], c.u);
+      const float area = 0.25f * (radius(0) + radius(2)) * (radius(1) + radius(3));
+      const float density = area > 0.0f ? r0 * r0 / area : 1.0f;
+      const float drag = std::min(1.0f, ip.hair_friction * density * h);
+      dv = -out_of_plane * nrm - drag * (rel - out_of_plane * nrm);
     }
   }
-  // Several contacts on one mass: their modifications are averaged, in list order.
-  auto apply_node = [&](std::uint32_t node) {
-    const float wgt = s.node_dv_weight[node];
-    if (wgt == 0.0f) return;
-    s.v[node] += s.node_dv[node] / std::max(wgt, 1.0f);
-    s.node_dv[node] = Vec3f::Zero();
-    s.node_dv_weight[node] = 0.0f;
-  };
-  for (const WispContact& c : contacts) {
-    if (c.envelope) {
-      const float wgt = s.env_dr_weight[c.point];
-      if (wgt != 0.0f) {
-        s.rdot[c.point] += s.env_dr[c.point] / std::max(wgt, 1.0f);
-        s.env_dr[c.point] = 0.0f;
-        s.env_dr_weight[c.point] = 0.0f;
-      }
-    } else {
-      apply_node(c.point);
+
+  // Momentum-conserving split between the point (mass mp) and the segment's skeleton
+  // (unit masses): equal masses give the paper's Delta v_p = -(...)/2.
+  const Vec3f dvp = dv * (1.0f / (1.0f + mp));
+  // The segment's nodes take the opposite impulse, shared linearly. In the average over a
+  // node's contacts, a contact counts by the share of the relative velocity it asks the
+  // node to absorb (1 for an equal mass, less for a light envelope mass), so that many
+  // light contacts do not dilute a heavy one.
+  const float share = 2.0f * mp / (1.0f + mp);
+  if (!c.envelope) return {dvp, 0.0f, share, true};
+  const float dr = dvp.dot(dir);
+  return {mp * dr * dir, dr, share, true};
+}
+
+void contact_accumulate(WispSystem& s, const WispContact& c, const ContactImpulse& r, std::uint32_t lo,
+                        std::uint32_t hi) {
+  if (!r.respond) return;
+  auto mine = [&](std::uint32_t node) { return node >= lo && node < hi; };
+  if (c.envelope) {
+    if (mine(c.point / kEnvelopePerSection)) {
+      s.env_dr[c.point] += r.dr;
+      s.env_dr_weight[c.point] += 1.0f;
     }
-    apply_node(c.seg);
-    apply_node(c.seg + 1);
+  } else if (mine(c.point)) {
+    s.node_dv[c.point] += r.impulse;
+    s.node_dv_weight[c.point] += 1.0f;
+  }
+  for (const auto& [node, weight] : {std::pair{c.seg, 1.0f - c.u}, std::pair{c.seg + 1, c.u}}) {
+    if (!mine(node) || s.pinned[node]) continue;
+    s.node_dv[node] -= weight * r.impulse;
+    s.node_dv_weight[node] += weight * r.share;
+  }
+}
+
+namespace {
+
+// Several contacts on one mass: their modifications are averaged (once all of them are
+// accumulated, in list order).
+void apply_node(WispSystem& s, std::uint32_t node) {
+  const float wgt = s.node_dv_weight[node];
+  if (wgt == 0.0f) return;
+  s.v[node] += s.node_dv[node] / std::max(wgt, 1.0f);
+  s.node_dv[node] = Vec3f::Zero();
+  s.node_dv_weight[node] = 0.0f;
+}
+
+void apply_envelope(WispSystem& s, std::uint32_t point) {
+  const float wgt = s.env_dr_weight[point];
+  if (wgt == 0.0f) return;
+  s.rdot[point] += s.env_dr[point] / std::max(wgt, 1.0f);
+  s.env_dr[point] = 0.0f;
+  s.env_dr_weight[point] = 0.0f;
+}
+
+}  // namespace
+
+void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,
+                           std::span<const WispParams> params, float h) {
+  constexpr std::uint32_t kAll = std::numeric_limits<std::uint32_t>::max();
+  for (const WispContact& c : contacts) contact_accumulate(s, c, contact_impulse(s, c, ip, params, h), 0, kAll);
+  for (const WispContact& c : contacts) {
+    if (c.envelope)
+      apply_envelope(s, c.point);
+    else
+      apply_node(s, c.point);
+    apply_node(s, c.seg);
+    apply_node(s, c.seg + 1);
+  }
+}
+
+void wisp_contacts_apply(WispSystem& s, std::span<const WispContact> contacts, std::span<const ContactImpulse> impulses,
+                         std::uint32_t lo, std::uint32_t hi) {
+  for (std::size_t i = 0; i < contacts.size(); ++i) contact_accumulate(s, contacts[i], impulses[i], lo, hi);
+  for (std::uint32_t node = lo; node < hi; ++node) {
+    apply_node(s, node);
+    for (int q = 0; q < kEnvelopePerSection; ++q) apply_envelope(s, kEnvelopePerSection * node + q);
   }
 }
 

@@ -237,9 +237,30 @@ struct SegmentVolume {
 // as averages per mass: quasi-parallel wisps (orientations within acos(parallel_cos),
 // relative velocity within asin(in_plane_sin) of their common plane) lose the relative
 // velocity normal to that plane and get a viscous in-plane drag min(1, hair_friction *
-// density * h), h the period the response stands for; other contacts are inelastic collisions (relative velocity removed).
-// Splits are momentum-conserving: equal masses give the paper's halves.
+// density * h), h the period the response stands for; other contacts are inelastic
+// collisions (relative velocity removed). Splits are momentum-conserving: equal masses
+// give the paper's halves.
 void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,
                            std::span<const WispParams> params, float h);
+
+// The same response in two parts, for threads (issue 10): each contact's impulse depends
+// only on the state before the response, so the impulses of any ranges of contacts can be
+// found at once; the sums per mass then run in list order, each thread over the masses of
+// its own nodes, so every mass gets the same bits as from wisp_contacts_respond.
+struct ContactImpulse {
+  Vec3f impulse;  // on the point (a node's Delta v, or an envelope mass's along its half-line)
+  float dr;       // an envelope point's Delta rdot
+  float share;    // the contact's weight in the averages of the segment's nodes
+  bool respond;   // false where the point's node is pinned: no response at all
+};
+ContactImpulse contact_impulse(const WispSystem& s, const WispContact& c, const InteractionParams& ip,
+                              std::span<const WispParams> params, float h);
+// Adds contact c's response to the masses of nodes [lo, hi) (envelope masses by their node).
+void contact_accumulate(WispSystem& s, const WispContact& c, const ContactImpulse& r, std::uint32_t lo,
+                        std::uint32_t hi);
+// Every contact's response on the masses of nodes [lo, hi), in list order, then applied
+// as averages (impulses[i]: contact_impulse of contacts[i]).
+void wisp_contacts_apply(WispSystem& s, std::span<const WispContact> contacts, std::span<const ContactImpulse> impulses,
+                         std::uint32_t lo, std::uint32_t hi);
 
 }  // namespace hairbench::kernels

@@ -76,6 +76,8 @@ class PlanteWispModel final : public HairModel {
   template <class F>
   void stage_pass(StageTimes& times, std::string_view stage, F&& f);
   void detect_self_interactions();
+  // k::wisp_contacts_respond over the threads, for the contacts of the last detection.
+  void respond_to_contacts(float h);
 
   ModelContext ctx_;
   Schedule schedule_;
@@ -102,9 +104,13 @@ class PlanteWispModel final : public HairModel {
   std::vector<Vec4f> pos_;
 
   kernels::SegmentGrid grid_;
+  // The narrow phase's ranges of segments and their contacts (detect_self_interactions).
+  static constexpr std::size_t kChunksPerThread = 8;
   std::vector<std::vector<kernels::WispContact>> chunk_contacts_;
-  std::vector<std::vector<std::uint32_t>> chunk_mailbox_;
+  std::vector<std::size_t> chunk_bounds_;
+  std::vector<std::vector<std::uint32_t>> thread_mailbox_;
   std::vector<kernels::WispContact> contacts_;
+  std::vector<kernels::ContactImpulse> impulses_;  // per contact (respond_to_contacts)
   bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
