@@ -44,10 +44,17 @@ using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int coun
 using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                             std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
 
+// contact_impulse (wisp_kernels.h) of contacts [begin, end) into out[begin, end), with
+// the same bits.
+using ImpulsesFn = void (*)(const WispSystem& s, std::span<const WispContact> contacts, std::size_t begin,
+                            std::size_t end, const InteractionParams& ip, std::span<const WispParams> params, float h,
+                            ContactImpulse* out);
+
 struct Kernels {
   VelocitiesFn velocities;
   PositionsFn positions;
   ContactsFn contacts;
+  ImpulsesFn impulses;
 };
 
 // The variant for this CPU.

@@ -2,9 +2,8 @@
 // (kernels/CMakeLists.txt), each time with PLANTE_SOA_VARIANT naming the namespace; the
 // loops over lanes are written plainly so the compiler turns each into vector
 // instructions of that variant. Each lane repeats the operations of the per-wisp kernel
-// (wisp_kernels.cpp) in Eigen's evaluation order for 3-vectors: a dot product or squared
-// norm is x + (y + z) (Eigen's unrolled reduction halves the terms), a vector over a
-// scalar divides each component, sums of vector terms go left to right.
+// (wisp_kernels.cpp) in Eigen's evaluation order for 3-vectors (wisp_lanes.h).
+#include "kernels/cpu/wisp_lanes.h"
 #include "kernels/cpu/wisp_soa.h"
 
 #include <cmath>
@@ -24,24 +23,6 @@ constexpr int Q = kEnvelopePerSection;
 #define LANES _Pragma("GCC ivdep") for (int l = 0; l < W; ++l)
 #define EACH_Q _Pragma("GCC unroll 4") for (int q = 0; q < Q; ++q)
 
-struct F3 {
-  float x, y, z;
-};
-inline F3 sub(F3 a, F3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline F3 add(F3 a, F3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline F3 mul(float s, F3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline F3 quot(F3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
-inline float dot(F3 a, F3 b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
-inline F3 cross(F3 a, F3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-inline F3 pick(bool c, F3 a, F3 b) { return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z}; }
-
-// unit_or of wisp_kernels.cpp; `bad` is set where the fallback would be taken (set
-// without a branch, so that the lane loops stay vector code).
-inline F3 unit(F3 v, int& bad) {
-  const float n2 = dot(v, v);
-  bad |= !(n2 > 1e-24f);
-  return quot(v, std::sqrt(n2));
-}
 // minimal_rotate of wisp_kernels.cpp; `bad` is set on a half turn.
 inline F3 minimal_rotate(F3 a, F3 b, F3 v, int& bad) {
   const float c = dot(a, b);
@@ -345,7 +326,10 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
 // wisp_grid_kernel.cpp
 void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
               std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+// wisp_contact_kernel.cpp
+void impulses(const WispSystem& s, std::span<const WispContact> contacts, std::size_t begin, std::size_t end,
+              const InteractionParams& ip, std::span<const WispParams> params, float h, ContactImpulse* out);
 
-Kernels kernels() { return {velocities, positions, contacts}; }
+Kernels kernels() { return {velocities, positions, contacts, impulses}; }
 
 }  // namespace hairbench::kernels::wisp_soa::PLANTE_SOA_VARIANT

@@ -380,13 +380,13 @@ void PlanteWispModel::detect_self_interactions() {
 
 void PlanteWispModel::respond_to_contacts(float h) {
   // k::wisp_contacts_respond in its two parts (ContactImpulse): the impulses over ranges
-  // of contacts, then each thread sums them, in list order, on its own nodes' masses.
+  // of contacts (by the lane kernel), then each thread sums them, in list order, on its
+  // own nodes' masses.
   const std::size_t count = contacts_.size();
   impulses_.resize(count);
   const bool threads = ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
   auto impulses = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i)
-      impulses_[i] = k::contact_impulse(sys_, contacts_[i], interaction_, params_, h);
+    block_.impulses(sys_, contacts_, begin, end, interaction_, params_, h, impulses_.data());
   };
   const auto nodes = static_cast<std::uint32_t>(sys_.x.size());
   auto apply = [&](std::size_t begin, std::size_t end) {
