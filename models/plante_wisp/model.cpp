@@ -383,6 +383,7 @@ void PlanteWispModel::respond_to_contacts(float h) {
   // of contacts (by the lane kernel), then each thread sums them, in list order, on its
   // own nodes' masses.
   const std::size_t count = contacts_.size();
+  if (count == 0) return;
   impulses_.resize(count);
   const bool threads = ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
   auto impulses = [&](std::size_t begin, std::size_t end) {
