@@ -127,4 +127,44 @@ void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t
   }
 }
 
+namespace {
+
+// Node seg[i] + 1's masses (the node, then its envelope masses) in segment j's volume.
+void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, std::vector<WispContact>& out) {
+  const std::uint32_t k = g.seg[i] + 1;
+  if (s.pinned[k]) return;
+  const SegmentVolume& vol = g.vol[j];
+  const float u = vol.contains(s, s.x[k]);
+  if (u >= 0.0f) out.push_back({k, vol.a, u, 0});
+  for (int q = 0; q < kEnvelopePerSection; ++q) {
+    const float uq = vol.contains(s, envelope_point(s, k, q));
+    if (uq >= 0.0f) out.push_back({static_cast<std::uint32_t>(kEnvelopePerSection * k + q), vol.a, uq, 1});
+  }
+}
+
+}  // namespace
+
+void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
+                       std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
+  auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
+  for (std::size_t i = begin; i < end; ++i) {
+    const std::uint32_t a = g.seg[i];
+    for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
+      for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
+        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+          const std::size_t c = index(x, y, z);
+          for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it) {
+            const std::uint32_t j = g.cell_items[it];
+            if (j <= i || mailbox[j] == i) continue;
+            mailbox[j] = static_cast<std::uint32_t>(i);
+            const std::uint32_t b = g.seg[j];
+            if (g.wisp[j] == g.wisp[i] && b - a < 3) continue;  // b > a within a wisp
+            if ((g.lo[i].array() > g.hi[j].array()).any() || (g.lo[j].array() > g.hi[i].array()).any()) continue;
+            masses_in(g, s, i, j, out);
+            masses_in(g, s, j, i, out);
+          }
+        }
+  }
+}
+
 }  // namespace hairbench::kernels

@@ -59,6 +59,14 @@ inline constexpr int kMaxGridCells = 64;
 // Rebuilds the grid from the current state.
 void grid_build(SegmentGrid& g, const WispSystem& s);
 
+// The narrow phase as first written (plante_wisp_ref; issue 10 keeps it as the reference
+// of wisp_soa's ContactsFn, which finds the same contacts in the same order): for each
+// segment in [begin, end), every later segment of its cells, one pair at a time (box
+// test, then each of the five masses of either segment in the other's volume by
+// SegmentVolume::contains). `mailbox` as for ContactsFn.
+void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
+                       std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+
 // Bounds of `parts` contiguous ranges of segments with about equal candidates each:
 // range p is [bounds[p], bounds[p + 1]).
 void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t>& bounds);

@@ -562,6 +562,22 @@ SegmentVolume::SegmentVolume(const WispSystem& s, std::uint32_t seg) : a(seg), x
   reach2 = reach * reach;
 }
 
+float SegmentVolume::contains(const WispSystem& s, const Vec3f& p) const {
+  if (!(len2 > 0.0f)) return -1.0f;
+  const float u = (p - xa).dot(d) / len2;
+  if (!(u >= 0.0f && u <= 1.0f)) return -1.0f;
+  const Vec3f lateral = p - (xa + u * d);
+  Vec3f e1 = (1.0f - u) * s.e1[a] + u * s.e1[a + 1];
+  e1 = unit_or(e1 - e1.dot(t) * t, t_orth);
+  const Vec3f e2 = t.cross(e1);
+  const float alpha = lateral.dot(e1), beta = lateral.dot(e2);
+  const std::size_t ea = kEnvelopePerSection * a, eb = ea + kEnvelopePerSection;
+  const int qa = alpha >= 0.0f ? 0 : 2, qb = beta >= 0.0f ? 1 : 3;
+  const float ra = lerp(s.r[ea + qa], s.r[eb + qa], u), rb = lerp(s.r[ea + qb], s.r[eb + qb], u);
+  const float f = (alpha / ra) * (alpha / ra) + (beta / rb) * (beta / rb);
+  return f < 1.0f ? u : -1.0f;
+}
+
 ContactImpulse contact_impulse(const WispSystem& s, const WispContact& c, const InteractionParams& ip,
                               std::span<const WispParams> params, float h) {
   const std::uint32_t k = c.envelope ? c.point / kEnvelopePerSection : c.point;

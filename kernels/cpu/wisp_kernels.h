@@ -231,6 +231,9 @@ struct SegmentVolume {
 
   SegmentVolume() = default;
   SegmentVolume(const WispSystem& s, std::uint32_t seg);
+  // The test of one point p, as written above: its axial parameter u where p is inside,
+  // else -1 (plante_wisp_ref's narrow phase, grid_contacts_ref).
+  float contains(const WispSystem& s, const Vec3f& p) const;
 };
 
 // The response of every contact from the current state (§4.1), accumulated then applied

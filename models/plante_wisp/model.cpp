@@ -364,7 +364,10 @@ void PlanteWispModel::detect_self_interactions() {
       mailbox.assign(n, std::numeric_limits<std::uint32_t>::max());
       for (std::size_t c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
         chunk_contacts_[c].clear();
-        block_.contacts(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], mailbox, chunk_contacts_[c]);
+        // plante_wisp_ref: the narrow phase as first written, the reference of the vector one.
+        const k::wisp_soa::ContactsFn contacts =
+            schedule_ == Schedule::PerStage ? k::grid_contacts_ref : block_.contacts;
+        contacts(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], mailbox, chunk_contacts_[c]);
       }
     }
   };
