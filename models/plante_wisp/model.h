@@ -98,6 +98,7 @@ class PlanteWispModel final : public HairModel {
     std::uint32_t first, count;
   };
   std::vector<WispRun> runs_;
+  std::vector<std::size_t> run_bounds_;  // thread t's runs: [run_bounds_[t], run_bounds_[t + 1])
   kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();  // and the narrow phase
   std::vector<std::uint32_t> strand_wisp_;
   std::vector<Vec4f> coord_;  // per groom vertex
