@@ -217,44 +217,76 @@ TEST(PlanteWisp, RebuildIsDeterministic) {
 // (tressfx_ponytail_shake's motion): without that spring the last segment swung about
 // the pinned tip by 85 degrees here (on the ponytail, the rebuilt strands stretched past
 // 50% at frame 4); with it, it stays within 30 degrees.
-TEST(PlanteWisp, TipPinnedWispKeepsItsLastSegmentDirection) {
+// `count` such curls, 1 cm apart along z.
+Groom tip_pinned_curls(int count) {
   Groom g;
-  std::vector<Vec3f> pts;
   constexpr int kVertices = 16;
   constexpr float kRadius = 0.032f;
-  for (int i = 0; i < kVertices; ++i) {
-    const float a = std::numbers::pi_v<float> * static_cast<float>(i) / (kVertices - 1);
-    pts.push_back(Vec3f(0.2f + kRadius * std::sin(a), 0.1f + kRadius * std::cos(a), 0.0f));
+  for (int c = 0; c < count; ++c) {
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < kVertices; ++i) {
+      const float a = std::numbers::pi_v<float> * static_cast<float>(i) / (kVertices - 1);
+      pts.push_back(Vec3f(0.2f + kRadius * std::sin(a), 0.1f + kRadius * std::cos(a), 0.01f * static_cast<float>(c)));
+    }
+    g.add_strand(pts, 0);
+    g.positions.back().w() = 0.0f;
   }
-  g.add_strand(pts, 0);
-  g.positions.back().w() = 0.0f;
   g.region_names = {"all"};
   g.head_radius = 0.1f;
+  return g;
+}
+
+// The head shaking +-30 degrees at 1 Hz about y, under gravity.
+FrameInput shaking_head(int f) {
+  auto head_at = [](double t) {
+    return Affine3f(Eigen::AngleAxisf(static_cast<float>(std::numbers::pi / 6 * std::sin(2 * std::numbers::pi * t)),
+                                      Vec3f::UnitY()));
+  };
+  FrameInput in;
+  in.frame = f;
+  in.dt = 1.0 / 60.0;
+  in.t = (f + 1) * in.dt;
+  in.head_prev = head_at(in.t - in.dt);
+  in.head = head_at(in.t);
+  in.gravity = Vec3f(0.0f, -9.81f, 0.0f);
+  return in;
+}
+
+TEST(PlanteWisp, TipPinnedWispKeepsItsLastSegmentDirection) {
+  const Groom g = tip_pinned_curls(1);
   plante::PlanteWispModel m(ModelContext{nullptr});
   m.reset(g, plante_params(g));
   const auto& s = m.wisps();
   const std::uint32_t last = s.node_begin[1] - 1;
   ASSERT_TRUE(s.pinned[last] && !s.pinned[last - 1]);
   const Vec3f rest_dir = (s.rest_x[last] - s.rest_x[last - 1]).normalized();
-  auto head_at = [](double t) {
-    return Affine3f(Eigen::AngleAxisf(static_cast<float>(std::numbers::pi / 6 * std::sin(2 * std::numbers::pi * t)),
-                                      Vec3f::UnitY()));
-  };
   StageTimes times;
   double widest = 0.0;
   for (int f = 0; f < 120; ++f) {
-    FrameInput in;
-    in.frame = f;
-    in.dt = 1.0 / 60.0;
-    in.t = (f + 1) * in.dt;
-    in.head_prev = head_at(in.t - in.dt);
-    in.head = head_at(in.t);
-    in.gravity = Vec3f(0.0f, -9.81f, 0.0f);
+    const FrameInput in = shaking_head(f);
     m.step(in, times);
     const Vec3f dir = (s.x[last] - s.x[last - 1]).normalized();
     widest = std::max(widest, std::acos(std::clamp(double(dir.dot(in.head.linear() * rest_dir)), -1.0, 1.0)));
   }
   EXPECT_LT(widest * 180.0 / std::numbers::pi, 30.0);
+}
+
+// Wisps pinned at the tip go through the block kernels too (issue 10: 488 of
+// tressfx_ponytail_shake's wisps), the tip's spring on their lanes: 16 such curls, one
+// wisp each, agree bit for bit with the per-wisp kernels of plante_wisp_ref.
+TEST(PlanteWisp, TipPinnedWispsInABlockAgreeWithTheReference) {
+  const Groom g = tip_pinned_curls(16);
+  const ParamSet params = plante_params(g, {{"strands_per_wisp", 1}});
+  plante::PlanteWispModel fast(ModelContext{nullptr}), ref(ModelContext{nullptr}, plante::Schedule::PerStage);
+  fast.reset(g, params);
+  ref.reset(g, params);
+  ASSERT_EQ(fast.block_wisps(), 16u) << "the curls do not run as one block: the test would not reach its lanes";
+  StageTimes times;
+  for (int f = 0; f < 60; ++f) {
+    fast.step(shaking_head(f), times);
+    ref.step(shaking_head(f), times);
+    ASSERT_EQ(metrics::state_hash(fast.positions()), metrics::state_hash(ref.positions())) << "frame " << f;
+  }
 }
 
 // After the head stops, the hair settles back towards its rest shape: the bending

@@ -26,7 +26,7 @@ bool has_v4() {
 
 bool block_eligible(const WispSystem& s, std::size_t w) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
-  return e - b >= 3 && e - b <= static_cast<std::uint32_t>(kMaxNodes) && !(s.pinned[e - 1] && !s.pinned[e - 2]);
+  return e - b >= 3 && e - b <= static_cast<std::uint32_t>(kMaxNodes);
 }
 
 Kernels kernels() {

@@ -20,8 +20,7 @@ inline constexpr int kLanes = 16;
 // Longest wisp (in nodes) a block takes; longer ones go through the per-wisp kernels.
 inline constexpr int kMaxNodes = 32;
 
-// Whether wisp w can be a lane of a block: between 3 and kMaxNodes nodes, and not pinned
-// at its tip (the tip's bending spring to the head stays with wisp_forces_and_velocities).
+// Whether wisp w can be a lane of a block: between 3 and kMaxNodes nodes.
 bool block_eligible(const WispSystem& s, std::size_t w);
 
 // The `count` wisps `wisps` (1 <= count <= kLanes; each block_eligible, all of one node

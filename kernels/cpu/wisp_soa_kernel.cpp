@@ -176,6 +176,42 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       acc[i - 1].set(l, sub(acc[i - 1].get(l), sub(add(fk, fk2), damp)));
     }
   }
+  // A wisp pinned at its tip as well: its last free segment's bending spring towards the
+  // head-carried rest direction (see wisp_forces_and_velocities), on the lanes of such
+  // wisps. The target is Eigen's expression there, per lane (scalar code keeps its order).
+  bool any_tip = false;
+  int tip[W];
+  F3 tip_target[W];
+  for (int l = 0; l < W; ++l) {
+    const std::uint32_t b = blk.base[l];
+    tip[l] = s.pinned[b + n - 1] && !s.pinned[b + n - 2];
+    any_tip = any_tip || tip[l];
+    const Vec3f target =
+        tip[l] ? Vec3f(head_rot * (s.rest_x[b + n - 1] - s.rest_x[b + n - 2]).normalized()) : Vec3f::UnitX();
+    tip_target[l] = {target.x(), target.y(), target.z()};
+  }
+  if (any_tip) {
+    const int i = n - 1;  // the pinned tip; node i - 1 takes the spring
+    LANES {
+      const F3 t = seg_t[i].get(l);
+      axis[l] = cross(t, tip_target[l]);
+      sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
+      cos_angle[l] = dot(tip_target[l], t);
+    }
+    for (int l = 0; l < W; ++l)
+      angle[l] = tip[l] && sin_angle[l] > 1e-7f ? std::atan2(sin_angle[l], cos_angle[l]) : 0.0f;
+    LANES {
+      const float len = seg_len[i * W + l], l0 = rest_len[i * W + l];
+      const F3 t = seg_t[i].get(l);
+      const float torque = p.bending_stiffness * angle[l] * l0 * l0;
+      const F3 spring = mul(torque / len, cross(quot(axis[l], sin_angle[l]), t));
+      const F3 before = acc[i - 1].get(l);
+      const F3 turned = sin_angle[l] > 1e-7f ? sub(before, spring) : before;
+      const F3 dv = sub(v[i - 1].get(l), v[i].get(l));
+      const F3 damped = sub(turned, mul(p.bending_damping, sub(dv, mul(dot(dv, t), t))));
+      acc[i - 1].set(l, pick(tip[l] != 0, damped, before));
+    }
+  }
   // Envelope: radial springs, then ring springs, on the free nodes.
   const float sqrt2 = std::sqrt(2.0f);
   for (int i = 0; i < n; ++i) {
