@@ -278,9 +278,9 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   const std::size_t threads = ctx_.pool ? static_cast<std::size_t>(ctx_.pool->threads()) : 1;
   // The threads' shares of the runs, of about equal cost rather than equal counts: a
   // wisp through the per-wisp kernels costs about a seventh of a block (above), and such
-  // wisps gather where the groom has them (tressfx_ponytail_shake: 488 wisps pinned at
-  // the tip, most of them at the end of the list; with equal counts of runs the second
-  // thread took the larger share, and two threads ran the integration 1.3 times as fast as one).
+  // wisps gather where the groom has them (issue 10: tressfx_ponytail_shake's 488 single
+  // wisps, before tip-pinned wisps ran in blocks, lay mostly at the end of the list; with
+  // equal counts of runs two threads ran the integration only 1.3 times as fast as one).
   constexpr std::uint64_t kBlockCost = 7;
   std::vector<std::uint64_t> cost_before(runs_.size() + 1, 0);
   for (std::size_t i = 0; i < runs_.size(); ++i)
