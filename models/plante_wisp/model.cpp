@@ -387,14 +387,26 @@ void PlanteWispModel::detect_self_interactions() {
       }
     }
   };
-  if (ctx_.pool && threads > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
+  const bool pooled = ctx_.pool && threads > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
+  if (pooled)
     ctx_.pool->parallel_for(threads, run);
   else
     run(0, threads);
   // Chunks are contiguous ranges of segments: concatenated in order they are the serial
-  // list, whatever the thread count, the bounds and which thread ran which chunk.
-  contacts_.clear();
-  for (const auto& c : chunk_contacts_) contacts_.insert(contacts_.end(), c.begin(), c.end());
+  // list, whatever the thread count, the bounds and which thread ran which chunk. The
+  // chunks are copied over the threads (model 1: 6.9 M contacts, 110 MB, per detection).
+  chunk_offset_.assign(chunks + 1, 0);
+  for (std::size_t c = 0; c < chunks; ++c) chunk_offset_[c + 1] = chunk_offset_[c] + chunk_contacts_[c].size();
+  contacts_.resize(chunk_offset_[chunks]);
+  auto copy = [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c)
+      std::copy(chunk_contacts_[c].begin(), chunk_contacts_[c].end(),
+                contacts_.begin() + static_cast<std::ptrdiff_t>(chunk_offset_[c]));
+  };
+  if (pooled)
+    ctx_.pool->parallel_for(chunks, copy);
+  else
+    copy(0, chunks);
 }
 
 void PlanteWispModel::respond_to_contacts(float h) {

@@ -108,7 +108,7 @@ class PlanteWispModel final : public HairModel {
   // The narrow phase's ranges of segments and their contacts (detect_self_interactions).
   static constexpr std::size_t kChunksPerThread = 8;
   std::vector<std::vector<kernels::WispContact>> chunk_contacts_;
-  std::vector<std::size_t> chunk_bounds_;
+  std::vector<std::size_t> chunk_bounds_, chunk_offset_;
   std::vector<std::vector<std::uint32_t>> thread_mailbox_;
   std::vector<kernels::WispContact> contacts_;
   std::vector<kernels::ContactImpulse> impulses_;  // per contact (respond_to_contacts)
