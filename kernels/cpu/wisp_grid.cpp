@@ -17,7 +17,7 @@ void set_mass(SegmentMasses& m, int q, const Vec3f& p) {
 
 }  // namespace
 
-void grid_build(SegmentGrid& g, const WispSystem& s) {
+void grid_segments(SegmentGrid& g, const WispSystem& s) {
   g.seg.clear();
   for (std::size_t w = 0; w < s.wisp_count(); ++w) {
     const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
@@ -36,15 +36,10 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
   g.cell_lo.resize(n);
   g.cell_hi.resize(n);
   g.candidates.assign(n, 0);
-  if (n == 0) {
-    g.cell_start.assign(2, 0);
-    g.cell_items.clear();
-    g.dims = Eigen::Vector3i::Ones();
-    return;
-  }
-  Vec3f all_lo = Vec3f::Constant(INFINITY), all_hi = Vec3f::Constant(-INFINITY);
-  float widest = 0.0f;
-  for (std::size_t i = 0; i < n; ++i) {
+}
+
+void grid_setup(SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) {
     Vec3f lo = Vec3f::Constant(INFINITY), hi = Vec3f::Constant(-INFINITY);
     for (std::uint32_t k = g.seg[i]; k <= g.seg[i] + 1; ++k) {
       lo = lo.cwiseMin(s.x[k]);
@@ -63,9 +58,31 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
     g.mass_free[i] = !s.pinned[k];
     g.lo[i] = lo;
     g.hi[i] = hi;
-    all_lo = all_lo.cwiseMin(lo);
-    all_hi = all_hi.cwiseMax(hi);
-    widest = std::max(widest, (hi - lo).maxCoeff());
+  }
+}
+
+void grid_build(SegmentGrid& g, const WispSystem& s) {
+  grid_segments(g, s);
+  grid_setup(g, s, 0, g.size());
+  grid_cells(g);
+}
+
+void grid_cells(SegmentGrid& g) {
+  const std::size_t n = g.size();
+  if (n == 0) {
+    g.cell_start.assign(2, 0);
+    g.cell_items.clear();
+    g.dims = Eigen::Vector3i::Ones();
+    return;
+  }
+  // In segment order, whichever threads set the segments up (min and max keep a NaN or
+  // drop it by their order of operands).
+  Vec3f all_lo = Vec3f::Constant(INFINITY), all_hi = Vec3f::Constant(-INFINITY);
+  float widest = 0.0f;
+  for (std::size_t i = 0; i < n; ++i) {
+    all_lo = all_lo.cwiseMin(g.lo[i]);
+    all_hi = all_hi.cwiseMax(g.hi[i]);
+    widest = std::max(widest, (g.hi[i] - g.lo[i]).maxCoeff());
   }
   const float extent = (all_hi - all_lo).maxCoeff();
   g.cell = std::max({widest, extent / static_cast<float>(kMaxGridCells), 1e-6f});

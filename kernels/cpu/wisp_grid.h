@@ -56,8 +56,16 @@ struct SegmentGrid {
 // cells; the grid has at most kMaxGridCells per axis (wider cells beyond that).
 inline constexpr int kMaxGridCells = 64;
 
-// Rebuilds the grid from the current state.
+// Rebuilds the grid from the current state: grid_segments, grid_setup of every segment,
+// then grid_cells. In parts, so that grid_setup can run over ranges of segments on
+// several threads (issue 10); any split gives the same grid.
 void grid_build(SegmentGrid& g, const WispSystem& s);
+// The segments that take part, and every per-segment array sized for them.
+void grid_segments(SegmentGrid& g, const WispSystem& s);
+// Segments [begin, end): their boxes, volumes and masses.
+void grid_setup(SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end);
+// The cells, from the segments' boxes, and each segment's candidates.
+void grid_cells(SegmentGrid& g);
 
 // The narrow phase as first written (plante_wisp_ref; issue 10 keeps it as the reference
 // of wisp_soa's ContactsFn, which finds the same contacts in the same order): for each

@@ -365,8 +365,15 @@ std::size_t PlanteWispModel::block_wisps() const {
 }
 
 void PlanteWispModel::detect_self_interactions() {
-  k::grid_build(grid_, sys_);
-  const std::size_t n = grid_.size(), chunks = chunk_contacts_.size(), threads = thread_mailbox_.size();
+  const std::size_t chunks = chunk_contacts_.size(), threads = thread_mailbox_.size();
+  const bool pooled = ctx_.pool && threads > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
+  k::grid_segments(grid_, sys_);
+  const std::size_t n = grid_.size();
+  if (pooled)
+    ctx_.pool->parallel_for(n, [&](std::size_t begin, std::size_t end) { k::grid_setup(grid_, sys_, begin, end); });
+  else
+    k::grid_setup(grid_, sys_, 0, n);
+  k::grid_cells(grid_);
   // Chunks of about equal candidates (grid_split), several per thread, claimed as the
   // threads come free: a chunk's cost also depends on how many of its candidates are
   // contacts, which no count ahead of the test knows (issue 10: with one chunk of equal
@@ -387,7 +394,6 @@ void PlanteWispModel::detect_self_interactions() {
       }
     }
   };
-  const bool pooled = ctx_.pool && threads > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
   if (pooled)
     ctx_.pool->parallel_for(threads, run);
   else
