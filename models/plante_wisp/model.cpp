@@ -313,8 +313,8 @@ void PlanteWispModel::WispClock::lap(int stage) {
 
 template <class F>
 void PlanteWispModel::for_each(std::size_t count, F&& f) {
-  // Static partition (ThreadPool::parallel_for): each wisp's result does not depend on
-  // which thread runs it.
+  // Static partition (ThreadPool::parallel_for); every caller's results are the same
+  // whichever thread runs which range. Below threads_min_wisps wisps, one thread.
   if (ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
     ctx_.pool->parallel_for(count, [&](std::size_t begin, std::size_t end) { f(begin, end); });
   else
@@ -366,13 +366,9 @@ std::size_t PlanteWispModel::block_wisps() const {
 
 void PlanteWispModel::detect_self_interactions() {
   const std::size_t chunks = chunk_contacts_.size(), threads = thread_mailbox_.size();
-  const bool pooled = ctx_.pool && threads > 1 && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
   k::grid_segments(grid_, sys_);
   const std::size_t n = grid_.size();
-  if (pooled)
-    ctx_.pool->parallel_for(n, [&](std::size_t begin, std::size_t end) { k::grid_setup(grid_, sys_, begin, end); });
-  else
-    k::grid_setup(grid_, sys_, 0, n);
+  for_each(n, [&](std::size_t begin, std::size_t end) { k::grid_setup(grid_, sys_, begin, end); });
   k::grid_cells(grid_);
   // Chunks of about equal candidates (grid_split), several per thread, claimed as the
   // threads come free: a chunk's cost also depends on how many of its candidates are
@@ -394,10 +390,7 @@ void PlanteWispModel::detect_self_interactions() {
       }
     }
   };
-  if (pooled)
-    ctx_.pool->parallel_for(threads, run);
-  else
-    run(0, threads);
+  for_each(threads, run);
   // Chunks are contiguous ranges of segments: concatenated in order they are the serial
   // list, whatever the thread count, the bounds and which thread ran which chunk. The
   // chunks are copied over the threads (model 1: 6.9 M contacts, 110 MB, per detection).
@@ -409,10 +402,7 @@ void PlanteWispModel::detect_self_interactions() {
       std::copy(chunk_contacts_[c].begin(), chunk_contacts_[c].end(),
                 contacts_.begin() + static_cast<std::ptrdiff_t>(chunk_offset_[c]));
   };
-  if (pooled)
-    ctx_.pool->parallel_for(chunks, copy);
-  else
-    copy(0, chunks);
+  for_each(chunks, copy);
 }
 
 void PlanteWispModel::respond_to_contacts(float h) {
@@ -422,7 +412,6 @@ void PlanteWispModel::respond_to_contacts(float h) {
   const std::size_t count = contacts_.size();
   if (count == 0) return;
   impulses_.resize(count);
-  const bool threads = ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_);
   auto impulses = [&](std::size_t begin, std::size_t end) {
     block_.impulses(sys_, contacts_, begin, end, interaction_, params_, h, impulses_.data());
   };
@@ -431,13 +420,8 @@ void PlanteWispModel::respond_to_contacts(float h) {
     k::wisp_contacts_apply(sys_, contacts_, impulses_, static_cast<std::uint32_t>(begin),
                            static_cast<std::uint32_t>(end));
   };
-  if (threads) {
-    ctx_.pool->parallel_for(count, impulses);
-    ctx_.pool->parallel_for(nodes, apply);
-  } else {
-    impulses(0, count);
-    apply(0, nodes);
-  }
+  for_each(count, impulses);
+  for_each(nodes, apply);
 }
 
 // §5.1, once per integration step: (1) forces, (2) interaction detection at its rate,
@@ -653,10 +637,7 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
       }
     }
   };
-  if (ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
-    ctx_.pool->parallel_for(rest_.strand_count(), body);
-  else
-    body(0, rest_.strand_count());
+  for_each(rest_.strand_count(), body);
 }
 
 std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx, Schedule schedule) {
