@@ -111,18 +111,28 @@ void grid_cells(SegmentGrid& g) {
     g.item_lo[a].resize(items);
     g.item_hi[a].resize(items);
   }
+  g.item_first.resize(items);
+  g.self_begin.resize(n + 1);
+  g.self_items.resize(items);
   g.cell_fill.assign(g.cell_start.begin(), g.cell_start.end() - 1);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
-      for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+  std::uint32_t slot = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3i& lo = g.cell_lo[i];
+    g.self_begin[i] = slot;
+    for (int z = lo.z(); z <= g.cell_hi[i].z(); ++z)
+      for (int y = lo.y(); y <= g.cell_hi[i].y(); ++y)
+        for (int x = lo.x(); x <= g.cell_hi[i].x(); ++x) {
           const std::uint32_t it = g.cell_fill[index(x, y, z)]++;
           g.cell_items[it] = static_cast<std::uint32_t>(i);
           for (int a = 0; a < 3; ++a) {
             g.item_lo[a][it] = g.lo[i][a];
             g.item_hi[a][it] = g.hi[i][a];
           }
+          g.item_first[it] = static_cast<std::uint8_t>((x == lo.x()) | (y == lo.y()) << 1 | (z == lo.z()) << 2);
+          g.self_items[slot++] = it;
         }
+  }
+  g.self_begin[n] = slot;
   // A cell's items ascend (filled in segment order): the one of rank r has the rest after it.
   for (std::size_t c = 0; c < cells; ++c)
     for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it)

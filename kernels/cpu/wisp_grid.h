@@ -1,6 +1,7 @@
 // Broad phase of the wisp-wisp interactions (Plante et al. 2001 §4.1): a uniform 3D grid
-// over the bounding boxes of the wisp segments, and a mailbox per segment (Amanatides &
-// Woo) so that each pair of segments is tested once per detection.
+// over the bounding boxes of the wisp segments. Each pair of segments is tested once per
+// detection: in the first cell they share (SegmentGrid::item_first), or, in the
+// reference narrow phase, by a mailbox per segment (Amanatides & Woo).
 #pragma once
 
 #include "kernels/cpu/wisp_kernels.h"
@@ -43,6 +44,17 @@ struct SegmentGrid {
   // The bounding box of each entry of cell_items, coordinate by coordinate, so that a
   // cell's candidates are tested in one sequential sweep.
   std::array<std::vector<float>, 3> item_lo, item_hi;
+  // Per entry of cell_items, bit a (x, y, z) set where its segment's box starts in this
+  // cell along axis a (the cell's coordinate is its cell_lo[a]). A pair of segments is
+  // first met in the lowest cell they share in z, y, x order: per axis the larger of
+  // their cell_lo. So a segment i meets item j there first iff, on every axis where the
+  // cell lies past i's cell_lo, j's box starts in it; the narrow phase tests this with
+  // the boxes, and needs no mailbox (issue 10: the mailbox's branch, about one duplicate
+  // per new pair on model 1, was the hottest of the candidate loop).
+  std::vector<std::uint8_t> item_first;
+  // CSR: per segment, its own entry in each of its cells, in z, y, x order (the later
+  // segments of a cell follow it there).
+  std::vector<std::uint32_t> self_begin, self_items;
   std::vector<std::uint32_t> cell_fill;  // scratch of grid_build
   // Per segment, its candidates: the later segments in its cells, summed over the cells.
   // The narrow phase of segment i costs about that much, and it falls the more the later
@@ -71,7 +83,8 @@ void grid_cells(SegmentGrid& g);
 // of wisp_soa's ContactsFn, which finds the same contacts in the same order): for each
 // segment in [begin, end), every later segment of its cells, one pair at a time (box
 // test, then each of the five masses of either segment in the other's volume by
-// SegmentVolume::contains). `mailbox` as for ContactsFn.
+// SegmentVolume::contains). `mailbox` holds one entry per segment, all != any index in
+// [begin, end) on entry; a pair is tested where it is first met.
 void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                        std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
 

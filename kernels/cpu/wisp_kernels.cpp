@@ -554,6 +554,7 @@ float widest_radius(const WispSystem& s, std::uint32_t k) {
 
 SegmentVolume::SegmentVolume(const WispSystem& s, std::uint32_t seg) : a(seg), xa(s.x[seg]), d(s.x[seg + 1] - xa) {
   len2 = d.squaredNorm();
+  inv_len2 = 1.0f / len2;
   if (len2 > 0.0f) {
     t = d / std::sqrt(len2);
     t_orth = t.unitOrthogonal();

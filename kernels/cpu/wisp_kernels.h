@@ -218,10 +218,15 @@ struct WispContact {
 // lateral.e2, and ra, rb the radii of the envelope masses on the sides of alpha and beta
 // interpolated at u: (alpha/ra)^2 + (beta/rb)^2 < 1. The axis is set up once per
 // detection for the tests of many points (issue 10; the test: wisp_grid_kernel.cpp).
-struct SegmentVolume {
+// One cache line each (issue 10: the narrow phase reads the volumes of a segment's
+// partners in no order the prefetcher follows).
+struct alignas(64) SegmentVolume {
   std::uint32_t a = 0;
   Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
   float len2 = 0.0f;
+  // 1 / len2, for the narrow phase's cheap axial bound only (its margin is far above the
+  // rounding of a multiplication instead of the division); the test itself divides.
+  float inv_len2 = 0.0f;
   // (1.01 widest)^2, widest the widest envelope radius at either end. alpha^2 + beta^2
   // is the squared distance to the axis (e1, e2 an orthonormal basis of the plane normal
   // to it) and the interpolated radii are at most `widest`: a point farther than that

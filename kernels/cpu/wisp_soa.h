@@ -36,12 +36,12 @@ using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int coun
 // segments [begin, end) against every later segment sharing a cell with it: bounding
 // boxes, then the masses of each segment (node seg+1 and its envelope) tested against
 // the other's volume (§4.1). Segments of one wisp closer than
-// three apart along it are never a pair (neighbours touch by construction). `mailbox`
-// holds one entry per segment, all != any index in [begin, end) on entry. The contacts
+// three apart along it are never a pair (neighbours touch by construction). The contacts
 // come in a fixed order (segment, then cell, then segment index), so splitting the range
 // across threads and concatenating the outputs in range order gives the serial list.
+// Same contacts in the same order as grid_contacts_ref.
 using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
-                            std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+                            std::vector<WispContact>& out);
 
 // contact_impulse (wisp_kernels.h) of contacts [begin, end) into out[begin, end), with
 // the same bits.

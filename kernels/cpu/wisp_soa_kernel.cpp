@@ -449,7 +449,7 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
 
 // wisp_grid_kernel.cpp
 void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
-              std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+              std::vector<WispContact>& out);
 // wisp_contact_kernel.cpp
 void impulses(const WispSystem& s, std::span<const WispContact> contacts, std::size_t begin, std::size_t end,
               const InteractionParams& ip, std::span<const WispParams> params, float h, ContactImpulse* out);

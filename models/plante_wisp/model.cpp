@@ -378,15 +378,17 @@ void PlanteWispModel::detect_self_interactions() {
   std::atomic<std::size_t> next{0};
   auto run = [&](std::size_t tb, std::size_t te) {
     for (std::size_t t = tb; t < te; ++t) {
-      // A segment is tested once by one thread, so a thread's mailbox serves all its chunks.
+      // plante_wisp_ref: the narrow phase as first written, the reference of the vector
+      // one. A segment is tested once by one thread, so a thread's mailbox serves all its
+      // chunks.
       std::vector<std::uint32_t>& mailbox = thread_mailbox_[t];
-      mailbox.assign(n, std::numeric_limits<std::uint32_t>::max());
+      if (schedule_ == Schedule::PerStage) mailbox.assign(n, std::numeric_limits<std::uint32_t>::max());
       for (std::size_t c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
         chunk_contacts_[c].clear();
-        // plante_wisp_ref: the narrow phase as first written, the reference of the vector one.
-        const k::wisp_soa::ContactsFn contacts =
-            schedule_ == Schedule::PerStage ? k::grid_contacts_ref : block_.contacts;
-        contacts(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], mailbox, chunk_contacts_[c]);
+        if (schedule_ == Schedule::PerStage)
+          k::grid_contacts_ref(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], mailbox, chunk_contacts_[c]);
+        else
+          block_.contacts(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], chunk_contacts_[c]);
       }
     }
   };
