@@ -43,11 +43,26 @@ using PositionsFn = void (*)(WispSystem& s, const std::uint32_t* wisps, int coun
 using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                             std::vector<WispContact>& out);
 
+// What contact_impulse reads of a node, as two rows of 16 floats: the impulse kernel
+// takes a contact's point node and its segment's two nodes as whole rows, 16 contacts at
+// a time, and turns them into lanes by transposes (issue 10: the copies lane by lane,
+// about 45 a contact, took most of the kernel's time). Copies of the state, so the
+// lanes get the bits they would read from it.
+struct alignas(64) ContactNode {
+  enum : int { kX = 0, kV = 3, kN = 6, kR = 9, kRRest = 13, kEnvelopeMass = 14 };  // row `a`
+  enum : int { kE1 = 0, kE2 = 3, kRdot = 6 };                                      // row `b`
+  float a[16];  // x, v, n, the envelope radii r, r_rest, the envelope mass of the node's wisp
+  float b[16];  // e1, e2, the envelope rates rdot
+};
+// ContactNode of nodes [begin, end) into out[begin, end).
+void contact_nodes(const WispSystem& s, std::span<const WispParams> params, std::size_t begin, std::size_t end,
+                   ContactNode* out);
+
 // contact_impulse (wisp_kernels.h) of contacts [begin, end) into out[begin, end), with
-// the same bits.
-using ImpulsesFn = void (*)(const WispSystem& s, std::span<const WispContact> contacts, std::size_t begin,
-                            std::size_t end, const InteractionParams& ip, std::span<const WispParams> params, float h,
-                            ContactImpulse* out);
+// the same bits; `nodes` holds every node's ContactNode of the current state.
+using ImpulsesFn = void (*)(const WispSystem& s, const ContactNode* nodes, std::span<const WispContact> contacts,
+                            std::size_t begin, std::size_t end, const InteractionParams& ip,
+                            std::span<const WispParams> params, float h, ContactImpulse* out);
 
 struct Kernels {
   VelocitiesFn velocities;

@@ -68,9 +68,9 @@ struct Block {
   // A wisp's values lie in one run of floats (its nodes are consecutive), and a block
   // keeps them as rows of one float of every lane (V3: rows x, y, z of node 0, then of
   // node 1...). With AVX-512 the runs are read 16 floats a lane at a time and turned into
-  // rows by a 16 x 16 transpose (issue 10: instead of 16 scalar moves a row). (GCC 12
-  // warns that the unpack intrinsics' internal undefined operand may be uninitialised; it
-  // is a false positive, as in soa_rows.h.)
+  // rows by a 16 x 16 transpose (transpose16). (GCC 12 warns that the intrinsics'
+  // internal undefined operand may be uninitialised; it is a false positive, as in
+  // soa_rows.h.)
   static_assert(W == 16, "one 512-bit vector of lanes");
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -82,30 +82,6 @@ struct Block {
       for (int l = 0; l < 16; ++l) r[l] = _mm512_maskz_loadu_ps(tail, run[l] + k0);
       transpose16(r);
       for (int j = 0; j < take; ++j) _mm512_storeu_ps(rows + (k0 + j) * W, r[j]);
-    }
-  }
-  // r[l] element j -> r[j] element l.
-  static void transpose16(__m512* r) {
-    __m512 t[16], u[16];
-    for (int a = 0; a < 16; a += 2) {
-      t[a] = _mm512_unpacklo_ps(r[a], r[a + 1]);
-      t[a + 1] = _mm512_unpackhi_ps(r[a], r[a + 1]);
-    }
-    // u[4g + c]: element c of each 128-bit part, of rows 4g..4g+3.
-    for (int g = 0; g < 16; g += 4) {
-      u[g] = _mm512_shuffle_ps(t[g], t[g + 2], 0x44);
-      u[g + 1] = _mm512_shuffle_ps(t[g], t[g + 2], 0xEE);
-      u[g + 2] = _mm512_shuffle_ps(t[g + 1], t[g + 3], 0x44);
-      u[g + 3] = _mm512_shuffle_ps(t[g + 1], t[g + 3], 0xEE);
-    }
-    for (int c = 0; c < 4; ++c) {
-      const __m512 p = _mm512_shuffle_f32x4(u[c], u[4 + c], 0x88), q = _mm512_shuffle_f32x4(u[c], u[4 + c], 0xDD);
-      const __m512 p2 = _mm512_shuffle_f32x4(u[8 + c], u[12 + c], 0x88);
-      const __m512 q2 = _mm512_shuffle_f32x4(u[8 + c], u[12 + c], 0xDD);
-      r[c] = _mm512_shuffle_f32x4(p, p2, 0x88);
-      r[8 + c] = _mm512_shuffle_f32x4(p, p2, 0xDD);
-      r[4 + c] = _mm512_shuffle_f32x4(q, q2, 0x88);
-      r[12 + c] = _mm512_shuffle_f32x4(q, q2, 0xDD);
     }
   }
   void load(V3* dst, const std::vector<Vec3f>& src) const {
@@ -451,8 +427,9 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
 void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
               std::vector<WispContact>& out);
 // wisp_contact_kernel.cpp
-void impulses(const WispSystem& s, std::span<const WispContact> contacts, std::size_t begin, std::size_t end,
-              const InteractionParams& ip, std::span<const WispParams> params, float h, ContactImpulse* out);
+void impulses(const WispSystem& s, const ContactNode* nodes, std::span<const WispContact> contacts, std::size_t begin,
+              std::size_t end, const InteractionParams& ip, std::span<const WispParams> params, float h,
+              ContactImpulse* out);
 
 Kernels kernels() { return {velocities, positions, contacts, impulses}; }
 

@@ -409,15 +409,19 @@ void PlanteWispModel::detect_self_interactions() {
 
 void PlanteWispModel::respond_to_contacts(float h) {
   // k::wisp_contacts_respond in its two parts (ContactImpulse): the impulses over ranges
-  // of contacts (by the lane kernel), then each thread sums them, in list order, on its
-  // own nodes' masses.
+  // of contacts (by the lane kernel, from the nodes' rows), then each thread sums them, in
+  // list order, on its own nodes' masses.
   const std::size_t count = contacts_.size();
   if (count == 0) return;
   impulses_.resize(count);
-  auto impulses = [&](std::size_t begin, std::size_t end) {
-    block_.impulses(sys_, contacts_, begin, end, interaction_, params_, h, impulses_.data());
-  };
   const auto nodes = static_cast<std::uint32_t>(sys_.x.size());
+  contact_nodes_.resize(nodes);
+  for_each(nodes, [&](std::size_t begin, std::size_t end) {
+    k::wisp_soa::contact_nodes(sys_, params_, begin, end, contact_nodes_.data());
+  });
+  auto impulses = [&](std::size_t begin, std::size_t end) {
+    block_.impulses(sys_, contact_nodes_.data(), contacts_, begin, end, interaction_, params_, h, impulses_.data());
+  };
   auto apply = [&](std::size_t begin, std::size_t end) {
     k::wisp_contacts_apply(sys_, contacts_, impulses_, static_cast<std::uint32_t>(begin),
                            static_cast<std::uint32_t>(end));

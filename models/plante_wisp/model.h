@@ -112,6 +112,7 @@ class PlanteWispModel final : public HairModel {
   std::vector<std::vector<std::uint32_t>> thread_mailbox_;
   std::vector<kernels::WispContact> contacts_;
   std::vector<kernels::ContactImpulse> impulses_;  // per contact (respond_to_contacts)
+  std::vector<kernels::wisp_soa::ContactNode> contact_nodes_;  // per node, the impulses' input rows
   bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
