@@ -130,13 +130,11 @@ void grid_cells(SegmentGrid& g) {
           }
           g.item_first[it] = static_cast<std::uint8_t>((x == lo.x()) | (y == lo.y()) << 1 | (z == lo.z()) << 2);
           g.self_items[slot++] = it;
+          // A cell's items ascend (filled in segment order): the rest after it are later.
+          g.candidates[i] += g.cell_start[index(x, y, z) + 1] - it - 1;
         }
   }
   g.self_begin[n] = slot;
-  // A cell's items ascend (filled in segment order): the one of rank r has the rest after it.
-  for (std::size_t c = 0; c < cells; ++c)
-    for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it)
-      g.candidates[g.cell_items[it]] += g.cell_start[c + 1] - it - 1;
 }
 
 void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t>& bounds) {
