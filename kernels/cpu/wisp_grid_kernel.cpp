@@ -275,12 +275,47 @@ std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e
   return bits;
 }
 
+// The pairs the box tests leave, tested kDepth pairs after their loads were started:
+// a pair's partner segment lies anywhere in memory, and near_pair's first use of its
+// volume waited on the load (issue 10: the hottest instruction of the narrow phase).
+// First in, first out: the pairs keep their order.
+class PairQueue {
+ public:
+  PairQueue(const SegmentGrid& g, FullTests& full) : g_(g), full_(full) {}
+  ~PairQueue() {
+    while (head_ != tail_) test(ring_[head_++ % kDepth]);
+  }
+  void add(std::uint32_t i, std::uint32_t j) {
+    __builtin_prefetch(&g_.vol[j]);
+    __builtin_prefetch(&g_.mass[j]);
+    __builtin_prefetch(reinterpret_cast<const char*>(&g_.mass[j]) + 64);
+    if (tail_ - head_ == kDepth) test(ring_[head_++ % kDepth]);
+    ring_[tail_++ % kDepth] = {i, j};
+  }
+
+ private:
+  static constexpr std::uint32_t kDepth = 16;
+  struct Pair {
+    std::uint32_t i, j;
+  };
+  void test(Pair p) {
+    const std::uint32_t near = near_pair(g_, p.i, p.j);
+    if ((near & 0xff) != 0) full_.add(p.i, p.j);
+    if ((near >> 8) != 0) full_.add(p.j, p.i);
+  }
+  const SegmentGrid& g_;
+  FullTests& full_;
+  Pair ring_[kDepth];
+  std::uint32_t head_ = 0, tail_ = 0;
+};
+
 }  // namespace
 
 void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
               std::vector<WispContact>& out) {
   auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
   FullTests full(g, s, out);
+  PairQueue pairs(g, full);  // flushed before `full`
   for (std::size_t i = begin; i < end; ++i) {
     const auto i32 = static_cast<std::uint32_t>(i);
     const Eigen::Vector3i& lo = g.cell_lo[i];
@@ -295,24 +330,13 @@ void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std:
           // then for the pairs left, in item order: the same pairs in the same order as
           // testing each item in turn with a mailbox (grid_contacts_ref).
           for (std::uint32_t it = *self++ + 1; it < stop; it += 32) {
-            std::uint32_t bits = overlapping(g, it, std::min(stop, it + 32), g.lo[i], g.hi[i], past);
-            // The later segments' data lie far apart in memory: their loads are started
-            // together rather than one narrow phase after the other.
-            for (std::uint32_t rest = bits; rest != 0; rest &= rest - 1) {
-              const std::uint32_t j = g.cell_items[it + static_cast<std::uint32_t>(std::countr_zero(rest))];
-              __builtin_prefetch(&g.vol[j]);
-              __builtin_prefetch(&g.mass[j]);
-              __builtin_prefetch(reinterpret_cast<const char*>(&g.mass[j]) + 64);
-            }
-            for (; bits != 0; bits &= bits - 1) {
+            for (std::uint32_t bits = overlapping(g, it, std::min(stop, it + 32), g.lo[i], g.hi[i], past); bits != 0;
+                 bits &= bits - 1) {
               const std::uint32_t j = g.cell_items[it + static_cast<std::uint32_t>(std::countr_zero(bits))];
               // Later within a wisp: a wisp's segments are consecutive in seg, so j - i
               // is seg[j] - seg[i] there, and only the nearest need the wisp looked up.
               if (j - i32 < 3 && g.wisp[j] == g.wisp[i]) continue;
-              const std::uint32_t near = near_pair(g, i, j);
-              if (near == 0) continue;
-              if ((near & 0xff) != 0) full.add(i, j);
-              if ((near >> 8) != 0) full.add(j, i);
+              pairs.add(i32, j);
             }
           }
         }
