@@ -636,10 +636,14 @@ ContactImpulse contact_impulse(const WispSystem& s, const WispContact& c, const 
 
 void contact_accumulate(WispSystem& s, const WispContact& c, const ContactImpulse& r, std::uint32_t lo,
                         std::uint32_t hi) {
-  if (!r.respond) return;
   auto mine = [&](std::uint32_t node) { return node >= lo && node < hi; };
+  // Nothing of this range first: a thread's range has only some of the list's contacts,
+  // and then it reads nothing of their impulses.
+  const std::uint32_t k = c.envelope ? c.point / kEnvelopePerSection : c.point;
+  if (!mine(k) && !mine(c.seg) && !mine(c.seg + 1)) return;
+  if (!r.respond) return;
   if (c.envelope) {
-    if (mine(c.point / kEnvelopePerSection)) {
+    if (mine(k)) {
       s.env_dr[c.point] += r.dr;
       s.env_dr_weight[c.point] += 1.0f;
     }
