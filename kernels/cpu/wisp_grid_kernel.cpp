@@ -31,17 +31,14 @@ __m512 halves(const float* lo, const float* hi) {
 }
 #endif
 
-// Cheap bounds of the masses of a pair of segments against each other's volume (issue
-// 10): the axial one of the full test (masses_in), widened by far more than rounding
-// (these sums may round otherwise, and the quotient by len2 is a product with its
-// reciprocal), and the distance to the axis within vol.reach2. Most masses are outside
-// one of them, and every mass the full test finds is inside both. Bit q (q < 5) is set
-// for mass q of i near the volume of j, bit 8 + q for mass q of j near the volume of i;
-// none for masses that are pinned or a volume that is degenerate (it holds nothing), all
-// for a volume so thin that 1 / len2 overflows (the full test decides).
-//
-// The masses of one segment against one volume fill 8 lanes (SegmentMasses); with
-// AVX-512 both directions run as one vector of 16, at the cost of one of 8.
+// Cheap bounds of the masses of segment i (node seg[i] + 1 and its envelope) against
+// the volume of segment j, 8 lanes for its 5 masses (issue 10): the axial one of the
+// full test (masses_in), widened by far more than rounding (these sums may round
+// otherwise, and the quotient by len2 is a product with its reciprocal), and the
+// distance to the axis within vol.reach2. Most masses are outside one of them, and
+// every mass the full test finds is inside both. Bit q for mass q; none where the
+// masses are pinned or the volume is degenerate (it holds nothing), all where it is so
+// thin that 1 / len2 overflows (the full test decides).
 std::uint32_t near_half(const SegmentVolume& vol, const SegmentMasses& m, bool free) {
   if (!free || !(vol.len2 > 0.0f)) return 0;
   if (!(vol.inv_len2 < INFINITY)) return (1u << kMassesPerSegment) - 1;
@@ -57,6 +54,9 @@ std::uint32_t near_half(const SegmentVolume& vol, const SegmentMasses& m, bool f
   return bits;
 }
 
+// near_half both ways for a pair: bits 0-4 for the masses of i near the volume of j,
+// bits 8-12 for those of j near the volume of i. With AVX-512 both directions run as one
+// vector of 16, at the cost of one of 8, with the same bounds.
 std::uint32_t near_pair(const SegmentGrid& g, std::size_t i, std::size_t j) {
   const SegmentVolume &vi = g.vol[i], &vj = g.vol[j];
   const SegmentMasses &mi = g.mass[i], &mj = g.mass[j];
