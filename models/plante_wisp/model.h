@@ -113,7 +113,8 @@ class PlanteWispModel final : public HairModel {
   std::vector<kernels::WispContact> contacts_;
   std::vector<kernels::ContactImpulse> impulses_;  // per contact (respond_to_contacts)
   std::vector<kernels::wisp_soa::ContactNode> contact_nodes_;  // per node, the impulses' input rows
-  std::vector<std::uint32_t> node_bounds_;  // thread t sums the contacts on nodes [t, t + 1) (respond_to_contacts)
+  // Thread t sums the contacts on nodes [node_bounds_[t], node_bounds_[t + 1]) (respond_to_contacts).
+  std::vector<std::uint32_t> node_bounds_;
   bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::uint8_t> sphere_moves_;
