@@ -1,5 +1,6 @@
 // Properties Plante, Cani & Poulin 2001 claims for the layered wisp model (§3-§5),
 // checked on hand-built wisp pairs and on the built-in scenarios.
+#include "kernels/cpu/vec_math.h"
 #include "kernels/cpu/wisp_soa.h"
 #include "models/plante_wisp/model.h"
 #include "models/plante_wisp/settings.h"
@@ -8,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -396,6 +398,34 @@ TEST(PlanteWisp, FastAgreesBitForBitWithTheReference) {
   for (std::size_t f = 0; f < fast.deviation.size(); ++f) ASSERT_EQ(fast.deviation[f], slow.deviation[f]) << "frame " << f;
   const auto one = test::run(sc, {"plante_wisp"}, parallel, 1);
   EXPECT_EQ(one[0].state_hash, slow.state_hash);
+}
+
+// The bending springs' angle (kernels::atan2_upper) against libm's atan2 in double, in
+// float ulps of the exact angle: directions all round the upper half plane at radii
+// from 1e-6 to 1e6, and the reduction's switch at tan(π/8) sampled finely. Near 0 and
+// π the ulp is that of the angle itself.
+TEST(PlanteWisp, BendAngleWithin3UlpOfLibm) {
+  auto ulps = [](float y, float x) {
+    const double exact = std::atan2(double(y), double(x));
+    const float e = static_cast<float>(exact);
+    return std::abs(double(kernels::atan2_upper(y, x)) - exact) / double(std::nextafter(e, 4.0f) - e);
+  };
+  double worst = 0.0;
+  for (int r = -6; r <= 6; ++r)
+    for (int i = 1; i < 200000; ++i) {
+      const double a = std::numbers::pi * i / 200000.0, radius = std::pow(10.0, r);
+      const float y = static_cast<float>(radius * std::sin(a)), x = static_cast<float>(radius * std::cos(a));
+      if (y > 0.0f) worst = std::max(worst, ulps(y, x));
+    }
+  for (int i = -20000; i <= 20000; ++i) {
+    const float q = 0.41421356f * (1.0f + static_cast<float>(i) * 1e-6f);
+    worst = std::max({worst, ulps(q, 1.0f), ulps(1.0f, q), ulps(q, -1.0f), ulps(1.0f, -q)});
+  }
+  EXPECT_LE(worst, 3.0);
+  EXPECT_GT(kernels::atan2_upper(1e-7f, 1.0f), 0.0f);
+  EXPECT_FLOAT_EQ(kernels::atan2_upper(1.0f, 0.0f), static_cast<float>(std::numbers::pi / 2));
+  EXPECT_TRUE(std::isnan(kernels::atan2_upper(std::nanf(""), 1.0f)));
+  EXPECT_TRUE(std::isnan(kernels::atan2_upper(1.0f, std::nanf(""))));
 }
 
 // The baseline and x86-64-v4 builds of the block and narrow-phase kernels give the same

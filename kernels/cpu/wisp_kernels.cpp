@@ -1,5 +1,7 @@
 #include "kernels/cpu/wisp_kernels.h"
 
+#include "kernels/cpu/vec_math.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -260,7 +262,7 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     Vec3f fk = Vec3f::Zero(), fk2 = Vec3f::Zero();
     if (sin_angle > 1e-7f) {
       const float l0 = std::min(s.rest_len[k], s.rest_len[k - 1]);
-      const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * l0 * l0;
+      const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * l0 * l0;
       const Vec3f a = axis / sin_angle;
       fk = (torque / len) * a.cross(t);
       fk2 = (torque / len_prev) * a.cross(t_prev);
@@ -289,7 +291,7 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
       const float sin_angle = axis.norm();
       if (sin_angle > 1e-7f) {
         const float l0 = s.rest_len[e - 1];
-        const float torque = p.bending_stiffness * std::atan2(sin_angle, target.dot(t)) * l0 * l0;
+        const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * l0 * l0;
         // Node k moves against the rotation of t about the pinned node.
         s.acc[k] -= (torque / len) * (axis / sin_angle).cross(t);
       }

@@ -3,6 +3,7 @@
 // loops over lanes are written plainly so the compiler turns each into vector
 // instructions of that variant. Each lane repeats the operations of the per-wisp kernel
 // (wisp_kernels.cpp) in Eigen's evaluation order for 3-vectors (wisp_lanes.h).
+#include "kernels/cpu/vec_math.h"
 #include "kernels/cpu/wisp_lanes.h"
 #include "kernels/cpu/wisp_soa.h"
 
@@ -207,9 +208,8 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       acc[i].set(l, sub(acc[i].get(l), mul(f, t)));
     }
   }
-  // Bending springs: the angle's atan2 is the library's, lane by lane, between two
-  // vector loops.
-  float sin_angle[W], cos_angle[W], angle[W];
+  // Bending springs.
+  float sin_angle[W], angle[W];
   F3 axis[W];
   for (int i = 2; i < n; ++i) {
     LANES {
@@ -219,9 +219,8 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       const F3 target = minimal_rotate(nn[i - 2].get(l), t_prev, local, bad[l]);
       axis[l] = cross(t, target);
       sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
-      cos_angle[l] = dot(target, t);
+      angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(target, t)) : 0.0f;
     }
-    for (int l = 0; l < W; ++l) angle[l] = sin_angle[l] > 1e-7f ? std::atan2(sin_angle[l], cos_angle[l]) : 0.0f;
     LANES {
       const float len = seg_len[i * W + l], len_prev = seg_len[(i - 1) * W + l];
       const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
@@ -260,10 +259,8 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       const F3 t = seg_t[i].get(l);
       axis[l] = cross(t, tip_target[l]);
       sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
-      cos_angle[l] = dot(tip_target[l], t);
+      angle[l] = tip[l] && sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(tip_target[l], t)) : 0.0f;
     }
-    for (int l = 0; l < W; ++l)
-      angle[l] = tip[l] && sin_angle[l] > 1e-7f ? std::atan2(sin_angle[l], cos_angle[l]) : 0.0f;
     LANES {
       const float len = seg_len[i * W + l], l0 = rest_len[i * W + l];
       const F3 t = seg_t[i].get(l);
