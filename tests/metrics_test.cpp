@@ -126,6 +126,19 @@ TEST(Stability, DetectsNanStretchAndEscape) {
   EXPECT_NE(metrics::blowup_reason(rest, stretched, Vec3f::Zero()).find("edge length"), std::string::npos);
 }
 
+// The edge test's bound is 50% of the rest length either way, just inside and outside
+// it (blowup_reason screens squared lengths before taking the exact test).
+TEST(Stability, EdgeBoundIsFiftyPercentEitherWay) {
+  const Groom g = bent_groom(1, 4);
+  const metrics::RestInfo rest(g);
+  for (const float scale : {0.48f, 0.52f, 1.48f, 1.52f}) {
+    std::vector<Vec4f> p = g.positions;
+    p[3] = p[2] + scale * (p[3] - p[2]);
+    const bool flagged = metrics::blowup_reason(rest, p, Vec3f::Zero()).find("edge length") != std::string::npos;
+    EXPECT_EQ(flagged, scale < 0.5f || scale > 1.5f) << scale;
+  }
+}
+
 // "Farther than 10 L-bar from the head" is measured from the head body, which holds the
 // roots: a groom whose roots span many strand lengths (TestHair1: 11 cm strands up to
 // 1.06 m from its centre) is sane at rest, and a vertex is caught once it is 10 L-bar
