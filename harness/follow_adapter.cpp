@@ -6,8 +6,8 @@
 namespace hairbench {
 
 FollowHairsAdapter::FollowHairsAdapter(std::unique_ptr<HairModel> inner, const Groom& guides,
-                                       const tfx::FollowHairs& follow)
-    : inner_(std::move(inner)), guides_(guides), follow_(follow) {}
+                                       const tfx::FollowHairs& follow, ThreadPool* pool)
+    : inner_(std::move(inner)), guides_(guides), follow_(follow), pool_(pool) {}
 
 void FollowHairsAdapter::reset(const Groom& rest, const ParamSet& params) {
   // Anything else would make positions() disagree with the groom the metrics expect.
@@ -28,7 +28,7 @@ void FollowHairsAdapter::step(const FrameInput& in, StageTimes& out_times) {
 void FollowHairsAdapter::rebuild() {
   const std::span<const Vec4f> guides = inner_->positions();
   std::copy(guides.begin(), guides.end(), positions_.begin());
-  tfx::apply_follow_hairs(follow_, guides, std::span<Vec4f>(positions_).subspan(guides.size()));
+  tfx::apply_follow_hairs(follow_, guides, std::span<Vec4f>(positions_).subspan(guides.size()), pool_);
 }
 
 }  // namespace hairbench

@@ -13,8 +13,10 @@ namespace hairbench {
 
 class FollowHairsAdapter final : public HairModel {
  public:
-  // `guides` and `follow` must outlive the adapter; `follow` is laid out on `guides`.
-  FollowHairsAdapter(std::unique_ptr<HairModel> inner, const Groom& guides, const tfx::FollowHairs& follow);
+  // `guides`, `follow` and `pool` must outlive the adapter; `follow` is laid out on
+  // `guides`. The follow strands are rebuilt over the pool's threads (null: on the caller's).
+  FollowHairsAdapter(std::unique_ptr<HairModel> inner, const Groom& guides, const tfx::FollowHairs& follow,
+                     ThreadPool* pool);
 
   // `rest` is the full groom (guides, then follow strands); the inner model is reset
   // with the guides only.
@@ -32,6 +34,7 @@ class FollowHairsAdapter final : public HairModel {
   std::unique_ptr<HairModel> inner_;
   const Groom& guides_;
   const tfx::FollowHairs& follow_;
+  ThreadPool* pool_;
   std::vector<Vec4f> positions_;
 };
 

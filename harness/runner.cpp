@@ -191,7 +191,7 @@ std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc,
   ctx.skip_inert = skip_inert;
   std::unique_ptr<HairModel> m = info.make(ctx);
   // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
-  if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow);
+  if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow, &pool);
   m->reset(sc.groom, params);
   return m;
 }

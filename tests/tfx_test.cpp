@@ -3,6 +3,7 @@
 #include "scenarios/tfx/tfx.h"
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 #include <gtest/gtest.h>
 
@@ -583,6 +584,21 @@ TEST(FollowHairs, RigidMotionOfGuidesMovesFollowsRigidly) {
       rest.positions.begin() + static_cast<std::ptrdiff_t>(g.vertex_count()), rest.positions.end());
   for (Vec4f& p : expected) p.head<3>() = m * Vec3f(p.head<3>());
   EXPECT_LE(max_distance(out, expected), 1e-5 * mean_strand_length(g));
+}
+
+// Over a pool the strands are split between threads; each is written from the guides
+// alone, so the result is the serial one, bit for bit.
+TEST(FollowHairs, ThreadsGiveTheSerialBits) {
+  const Groom g = bent_groom(37, 12);
+  const FollowHairs f = make_follow_hairs(g, 4, 0.01, 2.0, 17);
+  std::vector<Vec4f> moved = g.positions;
+  for (std::size_t k = 0; k < moved.size(); ++k)
+    if (k % 12 >= 2) moved[k].x() += 0.003f * static_cast<float>(k % 12);
+  std::vector<Vec4f> serial(f.vertex_count()), threaded(f.vertex_count(), Vec4f::Constant(-1.0f));
+  apply_follow_hairs(f, moved, serial);
+  ThreadPool pool(3);
+  apply_follow_hairs(f, moved, threaded, &pool);
+  EXPECT_EQ(0, std::memcmp(serial.data(), threaded.data(), serial.size() * sizeof(Vec4f)));
 }
 
 TEST(FollowHairs, FollowTheGuideWhenItBends) {

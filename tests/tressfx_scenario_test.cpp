@@ -193,7 +193,7 @@ TEST(TressfxScenario, FollowHairsMoveWithTheirGuides) {
   const ModelInfo* info = find_model("han_m3");
   ASSERT_NE(info, nullptr);
   ThreadPool pool(2);
-  FollowHairsAdapter model(info->make(ModelContext{&pool}), sc.guides, *sc.follow);
+  FollowHairsAdapter model(info->make(ModelContext{&pool}), sc.guides, *sc.follow, &pool);
   model.reset(sc.groom, resolve_params(*info, sc, {}));
   const tfx::FollowHairs& f = *sc.follow;
   const std::size_t guide_vertices = sc.guides.vertex_count();

@@ -5,6 +5,7 @@
 #include "scenarios/tfx/tfx.h"
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/rng.h"
 
 #include <cmath>
@@ -190,15 +191,25 @@ FollowHairs make_follow_hairs(const Groom& guides, int per_guide, double radius,
   return out;
 }
 
-void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
-                        std::span<Vec4f> out_follow_positions) {
-  check_layout(follow, guide_positions.size(), out_follow_positions.size());
-  for (std::size_t s = 0; s < follow.strand_count(); ++s) {
+namespace {
+
+// Follow strands [first, last). A guide's follow strands are consecutive and share its
+// anchor, so its root frame is computed once for all of them (the same bits as once per
+// strand: the same inputs).
+void apply_range(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
+                 std::span<Vec4f> out_follow_positions, std::size_t first, std::size_t last) {
+  std::uint32_t frame_guide = std::numeric_limits<std::uint32_t>::max(), frame_anchor = 0;
+  Frame f{Vec3d::Zero(), Vec3d::Zero(), Vec3d::Zero()};
+  for (std::size_t s = first; s < last; ++s) {
     const std::uint32_t g = follow.guide[s];
     const std::uint32_t b = follow.guide_offsets[g];
     const std::uint32_t n = follow.guide_offsets[g + 1] - b;
     const std::span<const Vec4f> guide = guide_positions.subspan(b, n);
-    const Frame f = root_frame(guide, xyz(guide_positions[follow.anchor[s]]));
+    if (g != frame_guide || follow.anchor[s] != frame_anchor) {
+      f = root_frame(guide, xyz(guide_positions[follow.anchor[s]]));
+      frame_guide = g;
+      frame_anchor = follow.anchor[s];
+    }
     const std::uint32_t o = follow.follow_offsets[s];
     for (std::uint32_t i = 0; i < n; ++i) {
       const Vec3d d = follow.offsets[o + i].cast<double>();
@@ -207,6 +218,21 @@ void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_
                                           static_cast<float>(p.z()), i < 2 ? 0.0f : guide[i].w());
     }
   }
+}
+
+}  // namespace
+
+void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
+                        std::span<Vec4f> out_follow_positions, ThreadPool* pool) {
+  check_layout(follow, guide_positions.size(), out_follow_positions.size());
+  // Each strand is written from the guides alone: the same bits for any split.
+  const auto range = [&](std::size_t first, std::size_t last) {
+    apply_range(follow, guide_positions, out_follow_positions, first, last);
+  };
+  if (pool)
+    pool->parallel_for(follow.strand_count(), range);
+  else
+    range(0, follow.strand_count());
 }
 
 Groom expand_follow_hairs(const Groom& guides, const FollowHairs& follow) {

@@ -19,6 +19,10 @@
 #include <string_view>
 #include <vector>
 
+namespace hairbench {
+class ThreadPool;
+}
+
 namespace hairbench::tfx {
 
 // ---- .tfx strands ---------------------------------------------------------------------
@@ -138,9 +142,10 @@ Groom expand_follow_hairs(const Groom& guides, const FollowHairs& follow);
 // Rebuilds the follow strands from the current guide positions (the root frames are
 // recomputed from them on every call). out_follow_positions gets follow.vertex_count() vertices;
 // w is the guide vertex's w, with vertices 0 and 1 pinned. Throws std::invalid_argument
-// when a span does not match `follow`'s layout.
+// when a span does not match `follow`'s layout. With a pool, the strands are split over
+// its threads (same result).
 void apply_follow_hairs(const FollowHairs& follow, std::span<const Vec4f> guide_positions,
-                        std::span<Vec4f> out_follow_positions);
+                        std::span<Vec4f> out_follow_positions, ThreadPool* pool = nullptr);
 
 // ---- assets ---------------------------------------------------------------------------
 
