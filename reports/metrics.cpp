@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <iomanip>
 
@@ -64,12 +65,92 @@ double strand_jaggedness_raw(std::span<const Vec4f> s) {
   return std::sqrt(sum / static_cast<double>(n - 3));
 }
 
+namespace {
+
+// strand_jaggedness_raw of kLanes strands of n >= 4 vertices each at once, one strand per
+// lane: every lane repeats that function's operations in Eigen's order for 3-vectors
+// (sums left to right, cross product by components), so each strand gets the same bits,
+// and the loops over lanes vectorise, the divisions and square roots with them
+// (issue 10: the metrics cost about as much as a fast model's step in `compare`).
+constexpr int kLanes = 8;
+#define METRIC_LANES _Pragma("GCC ivdep") for (int l = 0; l < kLanes; ++l)
+
+struct Edges {
+  double x[kLanes], y[kLanes], z[kLanes], len[kLanes];
+};
+
+// Edge i -> i + 1 of each lane's strand, and its length.
+void lane_edges(std::span<const Vec4f> p, const std::size_t* begin, std::size_t i, Edges& e) {
+  METRIC_LANES {
+    const Vec4f& a = p[begin[l] + i];
+    const Vec4f& b = p[begin[l] + i + 1];
+    e.x[l] = double(b.x()) - double(a.x());
+    e.y[l] = double(b.y()) - double(a.y());
+    e.z[l] = double(b.z()) - double(a.z());
+    e.len[l] = std::sqrt((e.x[l] * e.x[l] + e.y[l] * e.y[l]) + e.z[l] * e.z[l]);
+  }
+}
+
+// curvature_binormal per lane.
+void lane_binormals(const Edges& e0, const Edges& e1, double (&kb)[3][kLanes]) {
+  METRIC_LANES {
+    const double lens = e0.len[l] * e1.len[l];
+    const double dot = (e0.x[l] * e1.x[l] + e0.y[l] * e1.y[l]) + e0.z[l] * e1.z[l];
+    const double denom = std::max(lens + dot, 1e-12 * std::max(lens, 1e-30));
+    kb[0][l] = 2.0 * (e0.y[l] * e1.z[l] - e0.z[l] * e1.y[l]) / denom;
+    kb[1][l] = 2.0 * (e0.z[l] * e1.x[l] - e0.x[l] * e1.z[l]) / denom;
+    kb[2][l] = 2.0 * (e0.x[l] * e1.y[l] - e0.y[l] * e1.x[l]) / denom;
+  }
+}
+
+void lane_jaggedness(std::span<const Vec4f> p, const std::size_t* begin, std::size_t n, double* out) {
+  Edges e0, e1;
+  double prev[3][kLanes], kb[3][kLanes], sum[kLanes];
+  lane_edges(p, begin, 0, e0);
+  lane_edges(p, begin, 1, e1);
+  lane_binormals(e0, e1, prev);
+  METRIC_LANES sum[l] = 0.0;
+  for (std::size_t i = 2; i + 1 < n; ++i) {
+    e0 = e1;
+    lane_edges(p, begin, i, e1);
+    lane_binormals(e0, e1, kb);
+    METRIC_LANES {
+      const double dx = kb[0][l] - prev[0][l], dy = kb[1][l] - prev[1][l], dz = kb[2][l] - prev[2][l];
+      sum[l] += (dx * dx + dy * dy) + dz * dz;
+      prev[0][l] = kb[0][l];
+      prev[1][l] = kb[1][l];
+      prev[2][l] = kb[2][l];
+    }
+  }
+  METRIC_LANES out[l] = std::sqrt(sum[l] / static_cast<double>(n - 3));
+}
+
+}  // namespace
+
 double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;
+  const std::size_t strands = g.strand_count();
   double sum = 0.0;
-  for (std::size_t s = 0; s < g.strand_count(); ++s)
-    sum += strand_jaggedness_raw(p.subspan(g.strand_begin(s), g.strand_size(s))) - rest.rest_jaggedness[s];
-  return sum / static_cast<double>(g.strand_count());
+  std::size_t begin[kLanes];
+  double raw[kLanes];
+  for (std::size_t s = 0; s < strands;) {
+    // kLanes strands of one size >= 4 together; the strands are added in order either way.
+    const std::size_t n = g.strand_size(s);
+    bool together = n >= 4 && s + kLanes <= strands;
+    for (int l = 0; l < kLanes && together; ++l) {
+      together = g.strand_size(s + l) == n;
+      begin[l] = g.strand_begin(s + l);
+    }
+    if (together) {
+      lane_jaggedness(p, begin, n, raw);
+      for (int l = 0; l < kLanes; ++l) sum += raw[l] - rest.rest_jaggedness[s + l];
+      s += kLanes;
+    } else {
+      sum += strand_jaggedness_raw(p.subspan(g.strand_begin(s), n)) - rest.rest_jaggedness[s];
+      ++s;
+    }
+  }
+  return sum / static_cast<double>(strands);
 }
 
 LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p) {
@@ -101,17 +182,19 @@ double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Af
   return std::sqrt(sum / static_cast<double>(p.size())) / rest.mean_strand_length;
 }
 
-// A vertex at squared distance d2 >= r^2 from the centre is at distance >= r and adds
-// nothing to a depth that starts at 0: r^2 of a float r is exact in double, and the
-// rounded square root is monotonic, so skipping its square root changes no bit.
+// Per sphere, the depth r - |v - c| is largest at the smallest squared distance: the
+// rounded square root and subtraction are monotonic, so the depth of the nearest vertex
+// is the bits of the largest depth (NaN distances are skipped, as std::max skipped
+// them). A depth below 0 adds nothing.
 double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
   double deepest = 0.0;
   for (const Vec4f& s : world_spheres) {
-    const double r = s.w(), r2 = r * r;
+    double nearest2 = std::numeric_limits<double>::infinity();
     for (const Vec4f& v : p) {
       const double d2 = (xyz(v) - xyz(s)).squaredNorm();
-      if (!(d2 >= r2)) deepest = std::max(deepest, r - std::sqrt(d2));
+      nearest2 = d2 < nearest2 ? d2 : nearest2;
     }
+    if (p.size() > 0) deepest = std::max(deepest, double(s.w()) - std::sqrt(nearest2));
   }
   return deepest;
 }
@@ -131,25 +214,34 @@ std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const 
   const Groom& g = *rest.groom;
   const double far = rest.head_extent + 10.0 * rest.mean_strand_length;
   const Eigen::Vector3d c = head_center.cast<double>();
-  // Squared bounds a little inside the tests' (0.98 far^2 against far^2; 0.26 r^2 and
-  // 2.2 r^2 against (0.5 r)^2 and (1.5 r)^2): only a length near a bound takes the exact test.
+  // A screen per strand first, without branches so that it vectorises: squared lengths
+  // against bounds a little inside the tests' (0.98 far^2 against far^2; 0.26 r^2 and
+  // 2.2 r^2 against (0.5 r)^2 and (1.5 r)^2), where NaN and Inf fail every comparison.
+  // Only a strand the screen flags takes the exact tests, in order, so the first failure
+  // reported is the same; the square roots and branches per vertex were most of this
+  // function's cost, which `compare` pays per model and frame (issue 10).
   constexpr double kNear = 0.98, kShort = 0.26, kLong = 2.2;
+  const double near2 = kNear * far * far;
   for (std::size_t s = 0; s < g.strand_count(); ++s) {
     const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
     const bool simulated = s < rest.simulated_strands;
+    int flagged = 0;
+    for (std::size_t i = b; i < b + n; ++i)
+      flagged |= static_cast<int>(!((xyz(p[i]) - c).squaredNorm() <= near2)) |
+                 static_cast<int>(!(p[i].w() * 0.0f == 0.0f));  // w: NaN or Inf
+    if (simulated)
+      for (std::size_t i = b + 1; i < b + n; ++i) {
+        const double l2 = (xyz(p[i]) - xyz(p[i - 1])).squaredNorm(), r2 = rest.rest_length[i] * rest.rest_length[i];
+        flagged |= static_cast<int>(!(l2 > kShort * r2)) | static_cast<int>(!(l2 < kLong * r2));
+      }
+    if (!flagged) continue;
     for (std::size_t i = b; i < b + n; ++i) {
       if (!p[i].allFinite())
         return "non-finite position (strand " + std::to_string(s) + ", vertex " + std::to_string(i - b) + ")";
-      // The squared distances are screened first with margins far above rounding, and
-      // the tests themselves run only near their bounds: the square roots were most of
-      // this function's cost.
-      const double d2 = (xyz(p[i]) - c).squaredNorm();
-      if (d2 > kNear * far * far && (xyz(p[i]) - c).norm() > far)
+      if ((xyz(p[i]) - c).norm() > far)
         return "vertex farther than 10 mean strand lengths from the head (strand " + std::to_string(s) + ")";
       if (simulated && i > b) {
-        const double l2 = (xyz(p[i]) - xyz(p[i - 1])).squaredNorm(), r = rest.rest_length[i];
-        if (l2 > kShort * r * r && l2 < kLong * r * r) continue;
-        const double e = std::abs(std::sqrt(l2) - r) / r;
+        const double e = std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
         if (e > 0.5)
           return "edge length error above 50% (strand " + std::to_string(s) + ", edge " + std::to_string(i - b) + ")";
       }
