@@ -11,6 +11,32 @@ namespace hairbench::metrics {
 
 namespace {
 Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
+
+// The per-frame metrics cost about as much as a fast model's step in `compare`, which
+// computes them per model and frame (issue 10). Their hot loops are built twice, for
+// x86-64-v4 (AVX-512) and the baseline, and chosen at load time; the IEEE operations
+// give the same bits in either (no FMA contraction, -ffp-contract=off).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define METRIC_CLONES __attribute__((target_clones("arch=x86-64-v4", "default")))
+#else
+#define METRIC_CLONES
+#endif
+// Their helpers are inlined into each build (a call would run the baseline build).
+#define METRIC_INLINE [[gnu::always_inline]] inline
+
+// A sum's terms are computed kChunk at a time into a buffer, by a loop that vectorises,
+// and added in order after it: the same additions in the same order as in one loop, so
+// the same bits, without each term's arithmetic waiting on the running sum.
+constexpr std::size_t kChunk = 256;
+template <class Term, class Add>
+METRIC_INLINE void chunked(std::size_t begin, std::size_t end, Term term, Add add) {
+  double buf[kChunk];
+  for (std::size_t c = begin; c < end; c += kChunk) {
+    const std::size_t m = std::min(kChunk, end - c);
+    for (std::size_t k = 0; k < m; ++k) buf[k] = term(c + k);
+    for (std::size_t k = 0; k < m; ++k) add(buf[k]);
+  }
+}
 }  // namespace
 
 RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
@@ -27,9 +53,11 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
   }
 }
 
-double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
+METRIC_CLONES double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
   double sum = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) sum += (xyz(p[i]) - xyz(ref[i])).squaredNorm();
+  chunked(
+      0, p.size(), [&](std::size_t i) { return (xyz(p[i]) - xyz(ref[i])).squaredNorm(); },
+      [&](double t) { sum += t; });
   return std::sqrt(sum / static_cast<double>(p.size())) / mean_length;
 }
 
@@ -80,7 +108,7 @@ struct Edges {
 };
 
 // Edge i -> i + 1 of each lane's strand, and its length.
-void lane_edges(std::span<const Vec4f> p, const std::size_t* begin, std::size_t i, Edges& e) {
+METRIC_INLINE void lane_edges(std::span<const Vec4f> p, const std::size_t* begin, std::size_t i, Edges& e) {
   METRIC_LANES {
     const Vec4f& a = p[begin[l] + i];
     const Vec4f& b = p[begin[l] + i + 1];
@@ -92,7 +120,7 @@ void lane_edges(std::span<const Vec4f> p, const std::size_t* begin, std::size_t 
 }
 
 // curvature_binormal per lane.
-void lane_binormals(const Edges& e0, const Edges& e1, double (&kb)[3][kLanes]) {
+METRIC_INLINE void lane_binormals(const Edges& e0, const Edges& e1, double (&kb)[3][kLanes]) {
   METRIC_LANES {
     const double lens = e0.len[l] * e1.len[l];
     const double dot = (e0.x[l] * e1.x[l] + e0.y[l] * e1.y[l]) + e0.z[l] * e1.z[l];
@@ -103,7 +131,7 @@ void lane_binormals(const Edges& e0, const Edges& e1, double (&kb)[3][kLanes]) {
   }
 }
 
-void lane_jaggedness(std::span<const Vec4f> p, const std::size_t* begin, std::size_t n, double* out) {
+METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const std::size_t* begin, std::size_t n, double* out) {
   Edges e0, e1;
   double prev[3][kLanes], kb[3][kLanes], sum[kLanes];
   lane_edges(p, begin, 0, e0);
@@ -127,7 +155,7 @@ void lane_jaggedness(std::span<const Vec4f> p, const std::size_t* begin, std::si
 
 }  // namespace
 
-double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
+METRIC_CLONES double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;
   const std::size_t strands = g.strand_count();
   double sum = 0.0;
@@ -153,32 +181,39 @@ double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
   return sum / static_cast<double>(strands);
 }
 
-LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p) {
+METRIC_CLONES LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;
   LengthError out;
   double sum = 0.0;
   std::size_t edges = 0;
   for (std::size_t s = 0; s < g.strand_count(); ++s) {
     const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
-    for (std::size_t i = b + 1; i < b + n; ++i) {
-      const double e = std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
-      sum += e * e;
-      out.max = std::max(out.max, e);
-      ++edges;
-    }
+    chunked(
+        b + 1, b + n,
+        [&](std::size_t i) {
+          return std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
+        },
+        [&](double e) {
+          sum += e * e;
+          out.max = std::max(out.max, e);
+          ++edges;
+        });
   }
   out.rms = edges ? std::sqrt(sum / static_cast<double>(edges)) : 0.0;
   return out;
 }
 
-double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Affine3f& head) {
+METRIC_CLONES double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Affine3f& head) {
   const Affine3f& h = head;
   double sum = 0.0;
   const auto& r = rest.groom->positions;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Vec3f goal = h * Vec3f(r[i].head<3>());
-    sum += (xyz(p[i]) - goal.cast<double>()).squaredNorm();
-  }
+  chunked(
+      0, p.size(),
+      [&](std::size_t i) {
+        const Vec3f goal = h * Vec3f(r[i].head<3>());
+        return (xyz(p[i]) - goal.cast<double>()).squaredNorm();
+      },
+      [&](double t) { sum += t; });
   return std::sqrt(sum / static_cast<double>(p.size())) / rest.mean_strand_length;
 }
 
@@ -186,14 +221,13 @@ double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Af
 // rounded square root and subtraction are monotonic, so the depth of the nearest vertex
 // is the bits of the largest depth (NaN distances are skipped, as std::max skipped
 // them). A depth below 0 adds nothing.
-double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
+METRIC_CLONES double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
   double deepest = 0.0;
   for (const Vec4f& s : world_spheres) {
     double nearest2 = std::numeric_limits<double>::infinity();
-    for (const Vec4f& v : p) {
-      const double d2 = (xyz(v) - xyz(s)).squaredNorm();
-      nearest2 = d2 < nearest2 ? d2 : nearest2;
-    }
+    chunked(
+        0, p.size(), [&](std::size_t i) { return (xyz(p[i]) - xyz(s)).squaredNorm(); },
+        [&](double d2) { nearest2 = d2 < nearest2 ? d2 : nearest2; });
     if (p.size() > 0) deepest = std::max(deepest, double(s.w()) - std::sqrt(nearest2));
   }
   return deepest;
@@ -210,7 +244,7 @@ double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_sphere
 // and change length whenever the guide turns against the offset, so their stretch is the
 // follow layer's, reported by length_error, not a blow-up of the model; NaN/Inf and the
 // distance test still cover them.
-std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center) {
+METRIC_CLONES std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center) {
   const Groom& g = *rest.groom;
   const double far = rest.head_extent + 10.0 * rest.mean_strand_length;
   const Eigen::Vector3d c = head_center.cast<double>();
