@@ -56,7 +56,12 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
 METRIC_CLONES double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
   double sum = 0.0;
   chunked(
-      0, p.size(), [&](std::size_t i) { return (xyz(p[i]) - xyz(ref[i])).squaredNorm(); },
+      0, p.size(),
+      [&](std::size_t i) {
+        const double dx = double(p[i].x()) - double(ref[i].x()), dy = double(p[i].y()) - double(ref[i].y()),
+                     dz = double(p[i].z()) - double(ref[i].z());
+        return (dx * dx + dy * dy) + dz * dz;  // Eigen's squaredNorm, written out so that it vectorises
+      },
       [&](double t) { sum += t; });
   return std::sqrt(sum / static_cast<double>(p.size())) / mean_length;
 }
@@ -220,14 +225,26 @@ METRIC_CLONES double rest_shape_error(const RestInfo& rest, std::span<const Vec4
 // Per sphere, the depth r - |v - c| is largest at the smallest squared distance: the
 // rounded square root and subtraction are monotonic, so the depth of the nearest vertex
 // is the bits of the largest depth (NaN distances are skipped, as std::max skipped
-// them). A depth below 0 adds nothing.
+// them). A depth below 0 adds nothing. The minimum is taken in kLanes running minima,
+// combined at the end: a minimum of squares (never -0) does not depend on the order.
 METRIC_CLONES double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
   double deepest = 0.0;
   for (const Vec4f& s : world_spheres) {
+    const double cx = s.x(), cy = s.y(), cz = s.z();
+    double lane_min[kLanes];
+    METRIC_LANES lane_min[l] = std::numeric_limits<double>::infinity();
+    const std::size_t whole = p.size() / kLanes * kLanes;
+    auto d2 = [&](std::size_t i) {
+      const double dx = double(p[i].x()) - cx, dy = double(p[i].y()) - cy, dz = double(p[i].z()) - cz;
+      return (dx * dx + dy * dy) + dz * dz;
+    };
+    for (std::size_t i = 0; i < whole; i += kLanes) METRIC_LANES {
+        const double d = d2(i + l);
+        lane_min[l] = d < lane_min[l] ? d : lane_min[l];
+      }
     double nearest2 = std::numeric_limits<double>::infinity();
-    chunked(
-        0, p.size(), [&](std::size_t i) { return (xyz(p[i]) - xyz(s)).squaredNorm(); },
-        [&](double d2) { nearest2 = d2 < nearest2 ? d2 : nearest2; });
+    for (std::size_t i = whole; i < p.size(); ++i) nearest2 = d2(i) < nearest2 ? d2(i) : nearest2;
+    for (int l = 0; l < kLanes; ++l) nearest2 = lane_min[l] < nearest2 ? lane_min[l] : nearest2;
     if (p.size() > 0) deepest = std::max(deepest, double(s.w()) - std::sqrt(nearest2));
   }
   return deepest;
