@@ -10,8 +10,8 @@ namespace hairbench {
 class ThreadPool;
 
 // Seconds to read, scale and write back `bytes` of floats with every thread of `pool`,
-// the best of ten passes after two warm-up passes; measured once per size and thread
-// count in a process and cached.
+// the best pass of at least 20 and 10 ms after two warm-up passes; measured once per
+// size and thread count in a process and cached.
 double stream_seconds(std::size_t bytes, ThreadPool& pool);
 
 }  // namespace hairbench
