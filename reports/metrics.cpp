@@ -28,6 +28,14 @@ Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
 // and added in order after it: the same additions in the same order as in one loop, so
 // the same bits, without each term's arithmetic waiting on the running sum.
 constexpr std::size_t kChunk = 256;
+
+// |a - b|^2 of two points in double: Eigen's (xyz(a) - xyz(b)).squaredNorm(), term by
+// term in its order, written out so that loops over points vectorise.
+METRIC_INLINE double distance2(const Vec4f& a, const Vec4f& b) {
+  const double dx = double(a.x()) - double(b.x()), dy = double(a.y()) - double(b.y()),
+               dz = double(a.z()) - double(b.z());
+  return (dx * dx + dy * dy) + dz * dz;
+}
 template <class Term, class Add>
 METRIC_INLINE void chunked(std::size_t begin, std::size_t end, Term term, Add add) {
   double buf[kChunk];
@@ -56,13 +64,7 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
 METRIC_CLONES double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
   double sum = 0.0;
   chunked(
-      0, p.size(),
-      [&](std::size_t i) {
-        const double dx = double(p[i].x()) - double(ref[i].x()), dy = double(p[i].y()) - double(ref[i].y()),
-                     dz = double(p[i].z()) - double(ref[i].z());
-        return (dx * dx + dy * dy) + dz * dz;  // Eigen's squaredNorm, written out so that it vectorises
-      },
-      [&](double t) { sum += t; });
+      0, p.size(), [&](std::size_t i) { return distance2(p[i], ref[i]); }, [&](double t) { sum += t; });
   return std::sqrt(sum / static_cast<double>(p.size())) / mean_length;
 }
 
@@ -230,20 +232,18 @@ METRIC_CLONES double rest_shape_error(const RestInfo& rest, std::span<const Vec4
 METRIC_CLONES double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
   double deepest = 0.0;
   for (const Vec4f& s : world_spheres) {
-    const double cx = s.x(), cy = s.y(), cz = s.z();
     double lane_min[kLanes];
     METRIC_LANES lane_min[l] = std::numeric_limits<double>::infinity();
     const std::size_t whole = p.size() / kLanes * kLanes;
-    auto d2 = [&](std::size_t i) {
-      const double dx = double(p[i].x()) - cx, dy = double(p[i].y()) - cy, dz = double(p[i].z()) - cz;
-      return (dx * dx + dy * dy) + dz * dz;
-    };
     for (std::size_t i = 0; i < whole; i += kLanes) METRIC_LANES {
-        const double d = d2(i + l);
+        const double d = distance2(p[i + l], s);
         lane_min[l] = d < lane_min[l] ? d : lane_min[l];
       }
     double nearest2 = std::numeric_limits<double>::infinity();
-    for (std::size_t i = whole; i < p.size(); ++i) nearest2 = d2(i) < nearest2 ? d2(i) : nearest2;
+    for (std::size_t i = whole; i < p.size(); ++i) {
+      const double d = distance2(p[i], s);
+      nearest2 = d < nearest2 ? d : nearest2;
+    }
     for (int l = 0; l < kLanes; ++l) nearest2 = lane_min[l] < nearest2 ? lane_min[l] : nearest2;
     if (p.size() > 0) deepest = std::max(deepest, double(s.w()) - std::sqrt(nearest2));
   }

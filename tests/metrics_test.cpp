@@ -37,6 +37,26 @@ TEST(Jaggedness, ZeroOnRestShape) {
   EXPECT_EQ(metrics::jaggedness(rest, g.positions), 0.0);
 }
 
+// Eight strands of one size go through the lane code together, the rest one at a time:
+// the groom value is the serial sum of strand_jaggedness_raw, bit for bit.
+TEST(Jaggedness, LanesGiveTheSerialBits) {
+  const Groom g = bent_groom(19, 12);
+  const metrics::RestInfo rest(g);
+  std::vector<Vec4f> p = g.positions;
+  for (std::size_t k = 0; k < p.size(); ++k) {  // bent out of their planes, unevenly
+    p[k].x() += 0.0013f * static_cast<float>((k * 3) % 7);
+    p[k].y() += 0.0021f * static_cast<float>((k * 7) % 5);
+    p[k].z() += 0.0017f * static_cast<float>((k * 5) % 11);
+  }
+  double serial = 0.0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s)
+    serial += metrics::strand_jaggedness_raw(std::span<const Vec4f>(p).subspan(g.strand_begin(s), g.strand_size(s))) -
+              rest.rest_jaggedness[s];
+  serial /= static_cast<double>(g.strand_count());
+  EXPECT_GT(serial, 0.0);
+  EXPECT_EQ(metrics::jaggedness(rest, p), serial);
+}
+
 TEST(Jaggedness, UnchangedByRigidMotion) {
   const Groom g = bent_groom();
   const metrics::RestInfo rest(g);
