@@ -10,20 +10,6 @@ namespace hairbench::kernels {
 
 namespace {
 
-// The compression branch stiffens as r0/r (§3.3: "a wisp becomes progressively stiffer
-// during a compression"); below this fraction of the rest radius the envelope mass is
-// stopped, which bounds the spring's slope at 16 times its rest value and keeps the
-// explicit integration (§5.3) stable at the default 1000 Hz.
-constexpr float kMinRadiusFraction = 0.25f;
-// The stretch branch is soft (radial_stretch) and a skeleton mass jerked by a contact
-// flings its envelope masses outwards (inertial force, wisp_forces_and_velocities): on
-// a groom starting inside a collider they reached 4 times the rest radius within a
-// frame, and the strands, whose section offsets scale with the envelope (§5.2), moved
-// by 3 rest radii between neighbouring sections. Beyond twice the rest radius the
-// envelope mass is stopped: a strand's offset (at most wisp_width_max edges) then moves
-// by at most as much again.
-constexpr float kMaxRadiusFraction = 2.0f;
-
 Vec3f unit_or(const Vec3f& v, const Vec3f& fallback) {
   const float n2 = v.squaredNorm();
   return n2 > 1e-24f ? Vec3f(v / std::sqrt(n2)) : fallback;
@@ -59,6 +45,8 @@ void WispSystem::resize_state() {
   node_body.assign(n, -1);
   env_body.assign(kEnvelopePerSection * n, -1);
   wisp_touches.assign(wisp_count(), 0);
+  body_list.assign((kEnvelopePerSection + 1) * n, 0);
+  body_list_size.assign((kEnvelopePerSection + 1) * wisp_count(), 0);
   seg_len.assign(n, 0.0f);
   seg_t.assign(n, Vec3f::Zero());
   node_dv.assign(n, Vec3f::Zero());
@@ -79,47 +67,72 @@ Vec3f minimal_rotate(const Vec3f& a, const Vec3f& b, const Vec3f& v) {
   return v * c + k.cross(v) + k * (k.dot(v) / (1.0f + c));
 }
 
-SectionFrame section_frame(const WispSystem& s, std::uint32_t k, float sfrac, const Eigen::Matrix3f& head_rot) {
-  const std::uint32_t j = sfrac > 0.0f ? k + 1 : sfrac < 0.0f ? k - 1 : k;
-  const float u = std::abs(sfrac);
-  auto axis = [&](const std::vector<Vec3f>& cur, const std::vector<Vec3f>& rest, std::uint32_t i) -> Vec3f {
-    const float wgt = s.frame_weight[i];
-    if (wgt == 1.0f) return cur[i];
-    return wgt * cur[i] + (1.0f - wgt) * (head_rot * rest[i]);
+NodeSection node_section(const WispSystem& s, std::uint32_t k, const Eigen::Matrix3f& head_rot) {
+  NodeSection ns;
+  const float wgt = s.frame_weight[k];
+  auto axis = [&](const std::vector<Vec3f>& cur, const std::vector<Vec3f>& rest) -> Vec3f {
+    if (wgt == 1.0f) return cur[k];
+    return wgt * cur[k] + (1.0f - wgt) * (head_rot * rest[k]);
   };
-  SectionFrame f;
-  f.origin = s.x[k] + u * (s.x[j] - s.x[k]);
-  const Vec3f e1k = axis(s.e1, s.rest_fe1, k), e2k = axis(s.e2, s.rest_fe2, k);
-  const Vec3f e1j = axis(s.e1, s.rest_fe1, j), e2j = axis(s.e2, s.rest_fe2, j);
-  f.e1 = unit_or(e1k + u * (e1j - e1k), s.e1[k]);
-  const Vec3f e2 = e2k + u * (e2j - e2k);
-  f.e2 = unit_or(e2 - e2.dot(f.e1) * f.e1, s.e2[k]);
-  f.n = f.e1.cross(f.e2);
-  const float* rk = &s.r[kEnvelopePerSection * k];
-  const float* rj = &s.r[kEnvelopePerSection * j];
-  const float ik = 1.0f / s.r_rest[k], ij = 1.0f / s.r_rest[j];
+  ns.e1 = axis(s.e1, s.rest_fe1);
+  ns.e2 = axis(s.e2, s.rest_fe2);
   // Near the root the envelope's scale is blended towards 1 like the axes: a strand
   // next to its own root is not squeezed towards the wisp's centre.
-  const float wk = s.frame_weight[k], wj = s.frame_weight[j];
-  auto scale = [&](int q) { return lerp(wk * rk[q] * ik + (1.0f - wk), wj * rj[q] * ij + (1.0f - wj), u); };
-  f.scale_a[0] = scale(0);
-  f.scale_b[0] = scale(1);
-  f.scale_a[1] = scale(2);
-  f.scale_b[1] = scale(3);
+  const float* r = &s.r[kEnvelopePerSection * k];
+  const float inv_rest = 1.0f / s.r_rest[k];
+  for (int q = 0; q < kEnvelopePerSection; ++q) ns.scale[q] = wgt * r[q] * inv_rest + (1.0f - wgt);
+  return ns;
+}
+
+namespace {
+
+// section_frame between node k and its neighbour j (k itself at sfrac 0), a fraction u of
+// the way, from their NodeSections.
+SectionFrame section_between(const WispSystem& s, std::uint32_t k, std::uint32_t j, float u, const NodeSection& at_k,
+                             const NodeSection& at_j) {
+  SectionFrame f;
+  f.origin = s.x[k] + u * (s.x[j] - s.x[k]);
+  f.e1 = unit_or(at_k.e1 + u * (at_j.e1 - at_k.e1), s.e1[k]);
+  const Vec3f e2 = at_k.e2 + u * (at_j.e2 - at_k.e2);
+  f.e2 = unit_or(e2 - e2.dot(f.e1) * f.e1, s.e2[k]);
+  f.n = f.e1.cross(f.e2);
+  f.scale_a[0] = lerp(at_k.scale[0], at_j.scale[0], u);
+  f.scale_b[0] = lerp(at_k.scale[1], at_j.scale[1], u);
+  f.scale_a[1] = lerp(at_k.scale[2], at_j.scale[2], u);
+  f.scale_b[1] = lerp(at_k.scale[3], at_j.scale[3], u);
   f.rest_radius = lerp(s.r_rest[k], s.r_rest[j], u);
   return f;
 }
 
-float section_weight(const WispSystem& s, std::uint32_t k, float sfrac) {
-  const std::uint32_t j = sfrac > 0.0f ? k + 1 : sfrac < 0.0f ? k - 1 : k;
-  return lerp(s.frame_weight[k], s.frame_weight[j], std::abs(sfrac));
+std::uint32_t section_neighbour(std::uint32_t k, float sfrac) {
+  return sfrac > 0.0f ? k + 1 : sfrac < 0.0f ? k - 1 : k;
 }
 
-Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& c, const Eigen::Matrix3f& head_rot) {
-  const SectionFrame f = section_frame(s, k, c.x(), head_rot);
+// The strand point at coordinates c in section frame f (strand_point).
+Vec3f point_in(const SectionFrame& f, const Vec4f& c) {
   const float a = c.y() * (c.y() >= 0.0f ? f.scale_a[0] : f.scale_a[1]);
   const float b = c.z() * (c.z() >= 0.0f ? f.scale_b[0] : f.scale_b[1]);
   return f.origin + a * f.e1 + b * f.e2 + c.w() * f.n;
+}
+
+}  // namespace
+
+SectionFrame section_frame(const WispSystem& s, std::uint32_t k, float sfrac, const Eigen::Matrix3f& head_rot) {
+  const std::uint32_t j = section_neighbour(k, sfrac);
+  return section_between(s, k, j, std::abs(sfrac), node_section(s, k, head_rot), node_section(s, j, head_rot));
+}
+
+float section_weight(const WispSystem& s, std::uint32_t k, float sfrac) {
+  return lerp(s.frame_weight[k], s.frame_weight[section_neighbour(k, sfrac)], std::abs(sfrac));
+}
+
+Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& c, const Eigen::Matrix3f& head_rot) {
+  return point_in(section_frame(s, k, c.x(), head_rot), c);
+}
+
+Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& c, const NodeSection* sections) {
+  const std::uint32_t j = section_neighbour(k, c.x());
+  return point_in(section_between(s, k, j, std::abs(c.x()), sections[k], sections[j]), c);
 }
 
 Vec4f strand_coord(const WispSystem& s, std::size_t w, std::uint32_t k, const Vec3f& p,
@@ -541,6 +554,22 @@ void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float d
       const float t = half_line_entry(s.x[k], dir, body.spheres[s.env_body[ei]]);
       if (t >= 0.0f) s.rdot[ei] = std::min(s.rdot[ei], std::max(0.0f, (t - s.r[ei]) / body.h));
     }
+  }
+}
+
+void wisp_body_list(WispSystem& s, std::size_t w) {
+  const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
+  std::uint32_t* out = &s.body_list[kBodyListSlots * b];
+  std::uint32_t* size = &s.body_list_size[kBodyListSlots * w];
+  // Slot by slot, each root to tip. The detection records no contact on a pinned node.
+  for (std::uint32_t slot = 0; slot < kBodyListSlots; ++slot) {
+    size[slot] = 0;
+    if (!s.wisp_touches[w]) continue;
+    for (std::uint32_t k = b; k < e; ++k) {
+      const int sphere = slot == 0 ? s.node_body[k] : s.env_body[kEnvelopePerSection * k + slot - 1];
+      if (sphere >= 0) out[size[slot]++] = k;
+    }
+    out += size[slot];
   }
 }
 

@@ -42,6 +42,21 @@ struct InteractionParams {
 // The envelope masses of a section, in this order along the section's axes e1, e2.
 inline constexpr int kEnvelopePerSection = 4;  // §5.2: "we use only four envelope mass-points"
 
+// The compression branch stiffens as r0/r (§3.3: "a wisp becomes progressively stiffer
+// during a compression"); below this fraction of the rest radius the envelope mass is
+// stopped, which bounds the spring's slope at 16 times its rest value and keeps the
+// explicit integration (§5.3) stable at the default 1000 Hz.
+inline constexpr float kMinRadiusFraction = 0.25f;
+// The stretch branch is soft (radial_stretch) and a skeleton mass jerked by a contact
+// flings its envelope masses outwards (inertial force, wisp_forces_and_velocities): on
+// a groom starting inside a collider they reached 4 times the rest radius within a
+// frame, and the strands, whose section offsets scale with the envelope (§5.2), moved
+// by 3 rest radii between neighbouring sections. Beyond twice the rest radius the
+// envelope mass is stopped: a strand's offset (at most wisp_width_max edges) then moves
+// by at most as much again.
+inline constexpr float kMaxRadiusFraction = 2.0f;
+
+
 // All wisps. Nodes of wisp w are [node_begin[w], node_begin[w+1]); node k's envelope
 // masses are 4k..4k+3 along +e1, +e2, -e1, -e2 of its section frame.
 struct WispSystem {
@@ -74,6 +89,10 @@ struct WispSystem {
   // Per wisp, whether that detection recorded any: the others' sliding contacts and
   // holds have nothing to do (issue 10).
   std::vector<std::uint8_t> wisp_touches;
+  // The same contacts as lists of nodes (wisp_body_list), for plante_wisp's passes
+  // between detections: wisp w's from body_list[5 node_begin[w]], in 5 slots (the
+  // skeleton masses, then the envelope masses q = 0..3) of body_list_size[5 w + slot].
+  std::vector<std::uint32_t> body_list, body_list_size;
   // Scratch of wisp_forces_and_velocities: length and direction of segment (k-1, k) at k.
   std::vector<float> seg_len;
   std::vector<Vec3f> seg_t;
@@ -116,6 +135,18 @@ inline Vec3f envelope_point(const WispSystem& s, std::size_t k, int q) {
 // strand edges by up to radius x angle - more than the edge itself for a centimetre-wide
 // wisp swinging by a radian.
 Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& coord, const Eigen::Matrix3f& head_rot);
+// The parts of a section frame that depend on one node k: its axes, blended towards the
+// head-carried rest axes by frame_weight, and its envelope's scale per half-axis
+// (current over rest radius), blended towards 1 alike.
+struct NodeSection {
+  Vec3f e1, e2;
+  float scale[kEnvelopePerSection];
+};
+NodeSection node_section(const WispSystem& s, std::uint32_t k, const Eigen::Matrix3f& head_rot);
+// strand_point from every node's NodeSection (`sections`, by node index), with the same
+// bits: plante_wisp's rebuild sets each node's up once per step instead of twice per
+// strand vertex that lies near it (issue 10).
+Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& coord, const NodeSection* sections);
 // frame_weight interpolated like the section of strand_point at coordinate sfrac.
 float section_weight(const WispSystem& s, std::uint32_t k, float sfrac);
 // The coordinates of p relative to node k of wisp w in the current state, exact for
@@ -166,7 +197,7 @@ void wisp_positions(WispSystem& s, std::size_t w, const Vec3f& root_e1, float h)
 // step (it carries a point on a head-attached sphere from where it was to where it is).
 struct BodyStep {
   std::span<const Vec4f> spheres;
-  std::span<const std::uint8_t> moves;
+  std::span<const std::int32_t> moves;  // 1 where the sphere moves with the head (int: the lane kernels gather it)
   Affine3f motion = Affine3f::Identity();
   float h = 0.0f;
   Vec3f surface_velocity(std::size_t i, const Vec3f& p) const {
@@ -198,6 +229,13 @@ void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body);
 // `drag` (viscous friction over the step); envelope masses only along their half-lines
 // (§5.1).
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag);
+
+// The contacts of wisp w's last detection as lists (body_list): plante_wisp's passes
+// between two detections visit only these (issue 10: on `shake` 2% of the masses are in
+// contact), 16 at a time (wisp_soa.h, body_slide and body_hold).
+void wisp_body_list(WispSystem& s, std::size_t w);
+// The lists' slots: skeleton masses, then envelope masses q = 0..3.
+inline constexpr std::uint32_t kBodyListSlots = kEnvelopePerSection + 1;
 
 // ---- Wisp-wisp interactions (§4.1) --------------------------------------------------
 

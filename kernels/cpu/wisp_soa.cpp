@@ -29,6 +29,12 @@ bool block_eligible(const WispSystem& s, std::size_t w) {
   return e - b >= 3 && e - b <= static_cast<std::uint32_t>(kMaxNodes);
 }
 
+BodyLanes::BodyLanes(const BodyStep& body)
+    : spheres(body.spheres.data()->data()), count(body.spheres.size()), moves(body.moves.data()), h(body.h) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) motion[r][c] = body.motion.matrix()(r, c);
+}
+
 void contact_nodes(const WispSystem& s, std::span<const WispParams> params, std::size_t begin, std::size_t end,
                    ContactNode* out) {
   for (std::size_t k = begin; k < end; ++k) {

@@ -64,11 +64,47 @@ using ImpulsesFn = void (*)(const WispSystem& s, const ContactNode* nodes, std::
                             std::size_t begin, std::size_t end, const InteractionParams& ip,
                             std::span<const WispParams> params, float h, ContactImpulse* out);
 
+// The rebuild's strand points (§5.2) of one strand of n vertices, vertex i at
+// coordinates coord[i] relative to node first_node + i: strand_point (from every node's
+// NodeSection, `sections`) into point[i] and section_weight into weight[i], 16 vertices
+// at a time, with the per-vertex kernel's bits.
+using StrandPointsFn = void (*)(const WispSystem& s, const NodeSection* sections, std::uint32_t first_node,
+                                const Vec4f* coord, std::uint32_t n, Vec3f* point, float* weight);
+
+// A BodyStep as the lane kernels read it, in plain floats: Eigen's fixed-size types may
+// be aligned, so laid out, differently in the ISA variants' builds (AVX-512 aligns a
+// 4 x 4 matrix to 64 bytes), so the variants do not read a BodyStep itself.
+struct BodyLanes {
+  const float* spheres;        // per sphere: xyz centre, radius
+  std::size_t count;           // spheres
+  const std::int32_t* moves;   // BodyStep::moves
+  float motion[3][4];          // the rows of BodyStep::motion's matrix
+  float h;
+  explicit BodyLanes(const BodyStep& body);
+};
+
+// plante_wisp's wisp-body passes between detections for the wisps [first, first +
+// count), over the contacts wisp_body_list listed: wisp_body_slide (its skeleton
+// masses, then its envelope masses) and wisp_body_hold, 16 masses at a time, with the
+// per-wisp kernels' bits (issue 10).
+using BodySlideFn = void (*)(WispSystem& s, std::uint32_t first, std::uint32_t count, const BodyLanes& body,
+                             float drag);
+using BodyHoldFn = void (*)(WispSystem& s, std::uint32_t first, std::uint32_t count, const BodyLanes& body);
+// wisp_body_detect for the block's wisps (as VelocitiesFn) where none of a wisp's masses
+// is inside a body: their contacts are recorded. Returns the lanes (bit l: wisps[l])
+// with a mass inside, which it leaves untouched for wisp_body_detect.
+using BodyDetectFn = std::uint32_t (*)(WispSystem& s, const std::uint32_t* wisps, int count, const BodyLanes& body,
+                                       float threshold);
+
 struct Kernels {
   VelocitiesFn velocities;
   PositionsFn positions;
   ContactsFn contacts;
   ImpulsesFn impulses;
+  StrandPointsFn strand_points;
+  BodySlideFn body_slide;
+  BodyHoldFn body_hold;
+  BodyDetectFn body_detect;
 };
 
 // The variant for this CPU.

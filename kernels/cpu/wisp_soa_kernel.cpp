@@ -418,6 +418,94 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
     if (bad[l]) wisp_positions(s, wisps[l], root_e1[l], h);
 }
 
+// wisp_body_detect for a block where no mass is inside a body (§4.2): then the
+// detection only records each free mass's nearest sphere within the threshold. Each
+// lane follows nearest_sphere (wisp_kernels.cpp): the first sphere of least gap
+// |p - c| - R. A lane with a mass inside (gap < 0) is left to the per-wisp kernel, which
+// moves the masses out.
+std::uint32_t body_detect(WispSystem& s, const std::uint32_t* wisps, int count, const BodyLanes& body,
+                          float threshold) {
+  Block blk(s, wisps, count);
+  const int n = blk.n;
+  V3 x[N], e1[N], e2[N];
+  float free[N * W], r[N * Q * W];
+  float node_body[N * W], env_body[N * Q * W];
+  blk.load(x, s.x);
+  blk.load(e1, s.e1);
+  blk.load(e2, s.e2);
+  blk.load_free(free, s.pinned);
+  blk.load(r, s.r, Q);
+  int* bad = blk.bad;
+  int touches[W] = {};
+  const int spheres = static_cast<int>(body.count);
+  // The lanes' masses at (px, py, pz): their nearest spheres into `out` (-1 for none
+  // within the threshold, or for a pinned node's masses).
+  float px[W], py[W], pz[W];
+  auto record = [&](int i, float* out) {
+    float gap[W], best[W];
+    LANES {
+      gap[l] = INFINITY;
+      best[l] = -1.0f;
+    }
+    for (int c = 0; c < spheres; ++c) {
+      const F3 centre{body.spheres[4 * c], body.spheres[4 * c + 1], body.spheres[4 * c + 2]};
+      const float radius = body.spheres[4 * c + 3], index = static_cast<float>(c);
+      LANES {
+        const F3 d = sub(F3{px[l], py[l], pz[l]}, centre);
+        const float g = std::sqrt(dot(d, d)) - radius;
+        const float was = gap[l], had = best[l];
+        const bool nearer = g < was;
+        gap[l] = nearer ? g : was;
+        best[l] = nearer ? index : had;
+      }
+    }
+    LANES {
+      // Bitwise & and |: a comparison after && is not vector code.
+      const bool contact = (free[i * W + l] != 0.0f) & (best[l] >= 0.0f) & (gap[l] < threshold);
+      out[l] = contact ? best[l] : -1.0f;
+      touches[l] |= contact;
+      bad[l] |= contact & (gap[l] < 0.0f);
+    }
+  };
+  for (int i = 0; i < n; ++i) {
+    LANES {
+      px[l] = x[i].x[l];
+      py[l] = x[i].y[l];
+      pz[l] = x[i].z[l];
+    }
+    record(i, &node_body[i * W]);
+    EACH_Q {
+      // envelope_dir: +e1, +e2, -e1, -e2.
+      const V3& axis = q % 2 == 0 ? e1[i] : e2[i];
+      const float sign = q < 2 ? 1.0f : -1.0f;
+      const float* rq = &r[(i * Q + q) * W];
+      LANES {
+        const F3 dir{sign * axis.x[l], sign * axis.y[l], sign * axis.z[l]};
+        const F3 p = add(x[i].get(l), mul(rq[l], dir));
+        px[l] = p.x;
+        py[l] = p.y;
+        pz[l] = p.z;
+      }
+      record(i, &env_body[(i * Q + q) * W]);
+    }
+  }
+  std::uint32_t fallback = 0;
+  for (int l = 0; l < count; ++l) {
+    if (bad[l]) {
+      fallback |= 1u << l;
+      continue;
+    }
+    const std::uint32_t b = blk.base[l];
+    for (int i = 0; i < n; ++i) {
+      s.node_body[b + i] = static_cast<std::int32_t>(node_body[i * W + l]);
+      for (int q = 0; q < Q; ++q)
+        s.env_body[Q * (b + i) + q] = static_cast<std::int32_t>(env_body[(i * Q + q) * W + l]);
+    }
+    s.wisp_touches[wisps[l]] = static_cast<std::uint8_t>(touches[l]);
+  }
+  return fallback;
+}
+
 }  // namespace
 
 // wisp_grid_kernel.cpp
@@ -428,6 +516,16 @@ void impulses(const WispSystem& s, const ContactNode* nodes, std::span<const Wis
               std::size_t end, const InteractionParams& ip, std::span<const WispParams> params, float h,
               ContactImpulse* out);
 
-Kernels kernels() { return {velocities, positions, contacts, impulses}; }
+// wisp_strand_kernel.cpp
+void strand_points(const WispSystem& s, const NodeSection* sections, std::uint32_t first_node, const Vec4f* coord,
+                   std::uint32_t n, Vec3f* point, float* weight);
+
+// wisp_body_kernel.cpp
+void body_slide(WispSystem& s, std::uint32_t first, std::uint32_t count, const BodyLanes& body, float drag);
+void body_hold(WispSystem& s, std::uint32_t first, std::uint32_t count, const BodyLanes& body);
+
+Kernels kernels() {
+  return {velocities, positions, contacts, impulses, strand_points, body_slide, body_hold, body_detect};
+}
 
 }  // namespace hairbench::kernels::wisp_soa::PLANTE_SOA_VARIANT

@@ -295,6 +295,9 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   contacts_.clear();
   contacts_known_ = false;
   pos_ = rest.positions;
+  strand_points_.assign(schedule_ == Schedule::Fused ? pos_.size() : 0, Vec3f::Zero());
+  strand_weights_.assign(strand_points_.size(), 0.0f);
+  node_sections_.assign(schedule_ == Schedule::Fused ? sys_.node_count() : 0, k::NodeSection{});
   rebuild(Affine3f::Identity());
 }
 
@@ -495,6 +498,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       body.motion = head * head_before.inverse();
       body.h = h;
     }
+    const k::wisp_soa::BodyLanes body_lanes(body);
     // Viscous friction over this step.
     const float drag = std::min(1.0f, interaction_.body_friction * h);
     // §5.1 per wisp, root to tip inside the kernels: (1) forces and (3) velocities, the
@@ -515,7 +519,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       }
       clock.lap(kIntegration);
       if (body_on) {
-        for (std::uint32_t w = run.first; w < run.first + run.count; ++w) k::wisp_body_slide(sys_, w, body, drag);
+        block_.body_slide(sys_, run.first, run.count, body_lanes, drag);
         clock.lap(kBody);
       }
     };
@@ -531,9 +535,22 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       }
       clock.lap(kIntegration);
       if (body_on) {
-        for (std::uint32_t l = 0; l < run.count; ++l) {
-          k::wisp_body_hold(sys_, run.first + l, body);
-          if (body_due) k::wisp_body_detect(sys_, run.first + l, body, root_e1[l], interaction_.contact_threshold);
+        block_.body_hold(sys_, run.first, run.count, body_lanes);
+        if (body_due) {
+          // The block kernel records the contacts of the wisps with no mass inside a body
+          // (nearly all); the per-wisp kernel moves the others' masses out.
+          std::uint32_t inside = ~0u;
+          if (run.count > 1) {
+            std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
+            for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
+            inside = block_.body_detect(sys_, ids.data(), static_cast<int>(run.count), body_lanes,
+                                        interaction_.contact_threshold);
+          }
+          for (std::uint32_t l = 0; l < run.count; ++l) {
+            if (inside >> l & 1u)
+              k::wisp_body_detect(sys_, run.first + l, body, root_e1[l], interaction_.contact_threshold);
+            k::wisp_body_list(sys_, run.first + l);
+          }
         }
         clock.lap(kBody);
       }
@@ -611,13 +628,31 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
 // near the root (root_blend), so the strand stays attached to its root.
 void PlanteWispModel::rebuild(const Affine3f& head) {
   const Eigen::Matrix3f head_rot = head.linear();
+  // plante_wisp sets up each node's part of the section frames once, then a strand's
+  // points 16 vertices at a time (issue 10); plante_wisp_ref, as first written, computes
+  // each point alone, the two nodes' parts included. Same bits.
+  const bool per_node = schedule_ == Schedule::Fused;
+  if (per_node) {
+    for_each(sys_.node_count(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k)
+        node_sections_[k] = k::node_section(sys_, static_cast<std::uint32_t>(k), head_rot);
+    });
+  }
   auto body = [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t nb = sys_.node_begin[strand_wisp_[s]];
       const std::uint32_t vb = rest_.strand_begin(s);
       const std::uint32_t n = rest_.strand_size(s);
       auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
-      auto point = [&](std::uint32_t i) { return k::strand_point(sys_, nb + i, coord_[vb + i], head_rot); };
+      if (per_node)
+        block_.strand_points(sys_, node_sections_.data(), nb, &coord_[vb], n, &strand_points_[vb],
+                             &strand_weights_[vb]);
+      auto point = [&](std::uint32_t i) {
+        return per_node ? strand_points_[vb + i] : k::strand_point(sys_, nb + i, coord_[vb + i], head_rot);
+      };
+      auto weight = [&](std::uint32_t i) {
+        return per_node ? strand_weights_[vb + i] : k::section_weight(sys_, nb + i, coord_[vb + i].x());
+      };
       // Root to tip, each free vertex anchored to the last pinned one before it ...
       Vec3f anchor = Vec3f::Zero();
       int last = -1;
@@ -632,8 +667,7 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
           last = static_cast<int>(i);
           continue;
         }
-        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
-        out.head<3>() = point(i) + (1.0f - wgt) * anchor;
+        out.head<3>() = point(i) + (1.0f - weight(i)) * anchor;
       }
       if (!pinned_after_free) continue;
       // ... or, where a pinned vertex follows nearer (a strand pinned at both ends), to it.
@@ -648,8 +682,7 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
         int prev = static_cast<int>(i) - 1;
         while (prev >= 0 && !pinned(static_cast<std::uint32_t>(prev))) --prev;
         if (prev >= 0 && static_cast<int>(i) - prev <= next - static_cast<int>(i)) continue;
-        const float wgt = k::section_weight(sys_, nb + i, coord_[vb + i].x());
-        pos_[vb + i].head<3>() = point(i) + (1.0f - wgt) * anchor;
+        pos_[vb + i].head<3>() = point(i) + (1.0f - weight(i)) * anchor;
       }
     }
   };

@@ -103,6 +103,10 @@ class PlanteWispModel final : public HairModel {
   std::vector<std::uint32_t> strand_wisp_;
   std::vector<Vec4f> coord_;  // per groom vertex
   std::vector<Vec4f> pos_;
+  // The rebuild's (plante_wisp): per node, and each vertex's section point and weight.
+  std::vector<kernels::NodeSection> node_sections_;
+  std::vector<Vec3f> strand_points_;
+  std::vector<float> strand_weights_;
 
   kernels::SegmentGrid grid_;
   // The narrow phase's ranges of segments and their contacts (detect_self_interactions).
@@ -117,7 +121,7 @@ class PlanteWispModel final : public HairModel {
   std::vector<std::uint32_t> node_bounds_;
   bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
-  std::vector<std::uint8_t> sphere_moves_;
+  std::vector<std::int32_t> sphere_moves_;
   std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};
 };
 
