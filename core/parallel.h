@@ -5,6 +5,7 @@
 // bit-identical for any thread count (no reductions across threads happen here).
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
@@ -32,13 +33,16 @@ class ThreadPool {
   void worker_loop(int index);
 
   std::vector<std::thread> workers_;
+  // A loop is published by bumping generation_ and finished when pending_ reaches 0. Both
+  // sides spin on these for a short while before they sleep on the condition variables
+  // (see kSpin in parallel.cpp).
   std::mutex mutex_;
   std::condition_variable wake_;
   std::condition_variable done_;
   const std::function<void(std::size_t, std::size_t)>* body_ = nullptr;
   std::size_t n_ = 0;
-  std::size_t generation_ = 0;
-  int pending_ = 0;
+  std::atomic<std::size_t> generation_{0};
+  std::atomic<int> pending_{0};
   bool stop_ = false;
 };
 
