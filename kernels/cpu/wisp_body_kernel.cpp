@@ -119,7 +119,8 @@ struct Contact {
   const F3 unit_off = quot(off, std::sqrt(n2));
   const F3 nrm = pick(n2 > 1e-24f, unit_off, F3{0.0f, 1.0f, 0.0f});
   // BodyStep::surface_velocity; motion * p is Eigen's 4 x 4 product with (p, 1), column
-  // by column.
+  // by column, as its SSE2 code in the baseline build of wisp_kernels.cpp adds them
+  // (no fused multiply-add; the bit-for-bit tests check it).
   const auto& m = body.motion;
   const F3 moved{((m[0][0] * p.x + m[0][1] * p.y) + m[0][2] * p.z) + m[0][3],
                  ((m[1][0] * p.x + m[1][1] * p.y) + m[1][2] * p.z) + m[1][3],
