@@ -99,6 +99,11 @@ class PlanteWispModel final : public HairModel {
   };
   std::vector<WispRun> runs_;
   std::vector<std::size_t> run_bounds_;  // thread t's runs: [run_bounds_[t], run_bounds_[t + 1])
+  // During a pass, the runs of thread t's range not yet taken (wisp_pass).
+  struct alignas(64) RunRange {
+    std::atomic<std::uint64_t> range{0};
+  };
+  std::vector<RunRange> run_ranges_;
   kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();  // and the narrow phase
   std::vector<std::uint32_t> strand_wisp_;
   std::vector<Vec4f> coord_;  // per groom vertex
