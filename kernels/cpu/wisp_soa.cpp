@@ -30,7 +30,10 @@ bool block_eligible(const WispSystem& s, std::size_t w) {
 }
 
 BodyLanes::BodyLanes(const BodyStep& body)
-    : spheres(body.spheres.data()->data()), count(body.spheres.size()), moves(body.moves.data()), h(body.h) {
+    : spheres(body.spheres.empty() ? nullptr : body.spheres.data()->data()),
+      count(body.spheres.size()),
+      moves(body.moves.data()),
+      h(body.h) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) motion[r][c] = body.motion.matrix()(r, c);
 }

@@ -686,7 +686,7 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
       const std::uint32_t vb = rest_.strand_begin(s);
       const std::uint32_t n = rest_.strand_size(s);
       auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
-      if (per_node)
+      if (per_node && n > 0)
         block_.strand_points(sys_, node_sections_.data(), nb, &coord_[vb], n, &strand_points_[vb],
                              &strand_weights_[vb]);
       auto point = [&](std::uint32_t i) {
