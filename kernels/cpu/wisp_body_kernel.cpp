@@ -56,8 +56,6 @@ bool any_touches(const WispSystem& s, std::uint32_t first, std::uint32_t count) 
   return any != 0;
 }
 
-[[gnu::always_inline]] inline F3 load3(const float* p, int i) { return {p[3 * i], p[3 * i + 1], p[3 * i + 2]}; }
-
 // The arrays the lanes read, as plain pointers taken before the lane loops (GCC makes
 // vector gathers only of loads at a loop-invariant base).
 struct Arrays {

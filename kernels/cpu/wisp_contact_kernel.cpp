@@ -131,8 +131,6 @@ void load(const ContactNode* nodes, std::span<const WispContact> contacts, std::
 }
 #endif
 
-inline float lerp(float a, float b, float u) { return a + u * (b - a); }
-
 }  // namespace
 
 // contact_impulse, lane by lane; see there for the physics.

@@ -26,6 +26,10 @@ inline F3 quot(F3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
 inline float dot(F3 a, F3 b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
 inline F3 cross(F3 a, F3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 inline F3 pick(bool c, F3 a, F3 b) { return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z}; }
+inline float lerp(float a, float b, float u) { return a + u * (b - a); }
+// Vector i of an array of 3-vectors (Vec3f) read as floats; forced inline, since a call
+// inside a lane loop keeps it scalar.
+[[gnu::always_inline]] inline F3 load3(const float* p, int i) { return {p[3 * i], p[3 * i + 1], p[3 * i + 2]}; }
 
 // unit_or of wisp_kernels.cpp; `bad` is set where the fallback would be taken (set
 // without a branch, so that the lane loops stay vector code).

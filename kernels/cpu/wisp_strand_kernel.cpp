@@ -20,11 +20,9 @@ constexpr int W = kLanes;
 constexpr int kSectionFloats = 10;
 static_assert(sizeof(NodeSection) == kSectionFloats * sizeof(float), "NodeSection is read as floats");
 
-F3 load3(const float* p, int i) { return {p[3 * i], p[3 * i + 1], p[3 * i + 2]}; }
 F3 section3(const float* p, int i, int at) {
   return {p[kSectionFloats * i + at], p[kSectionFloats * i + at + 1], p[kSectionFloats * i + at + 2]};
 }
-float lerp(float a, float b, float u) { return a + u * (b - a); }
 
 }  // namespace
 
