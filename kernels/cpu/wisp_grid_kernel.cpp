@@ -57,7 +57,7 @@ std::uint32_t near_half(const SegmentVolume& vol, const SegmentMasses& m, bool f
 // near_half both ways for a pair: bits 0-4 for the masses of i near the volume of j,
 // bits 8-12 for those of j near the volume of i. With AVX-512 both directions run as one
 // vector of 16, at the cost of one of 8, with the same bounds.
-std::uint32_t near_pair(const SegmentGrid& g, std::size_t i, std::size_t j) {
+[[gnu::always_inline]] inline std::uint32_t near_pair(const SegmentGrid& g, std::size_t i, std::size_t j) {
   const SegmentVolume &vi = g.vol[i], &vj = g.vol[j];
   const SegmentMasses &mi = g.mass[i], &mj = g.mass[j];
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
@@ -102,8 +102,9 @@ void emit(const SegmentGrid& g, std::size_t i, std::uint32_t a, std::uint32_t bi
 }
 
 // The masses of segment i in the volume of segment j, where near_pair found some near
-// it (the full test, with the frame's square root and divisions); appends contacts to out.
-void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, std::vector<WispContact>& out) {
+// it (the full test, with the frame's square root and divisions): bit q where mass q is
+// inside, at axial parameter axial[q] (8 of them).
+std::uint32_t masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, float* axial) {
   const SegmentVolume& vol = g.vol[j];
   const SegmentMasses& m = g.mass[i];
   alignas(32) std::int32_t near[SegmentMasses::kWidth];
@@ -123,7 +124,6 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
     dr[q] = r_at_a[q + kEnvelopePerSection] - r_at_a[q];
   }
   const float len2 = vol.len2;
-  alignas(32) float axial[SegmentMasses::kWidth];
   for (int q = 0; q < SegmentMasses::kWidth; ++q) {
     const float px = m.x[q] - xa[0], py = m.y[q] - xa[1], pz = m.z[q] - xa[2];
     const float u = (px * d[0] + (py * d[1] + pz * d[2])) / len2;
@@ -151,7 +151,7 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
   }
   std::uint32_t bits = 0;
   for (int q = 0; q < kMassesPerSegment; ++q) bits |= static_cast<std::uint32_t>(near[q]) << q;
-  emit(g, i, vol.a, bits, axial, out);
+  return bits;
 }
 
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
@@ -159,9 +159,10 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
 // of i2 against j2 in lanes 8-15 (issue 10: a test's chain of divisions and a square
 // root is long, and a vector of 16 costs what one of 8 does). Each lane performs
 // masses_in's operations in its order (unfused: -ffp-contract=off), so the same contacts
-// with the same axial parameters; they are appended as the two masses_in would.
-void masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t i1, std::size_t j1, std::size_t i2,
-                 std::size_t j2, std::vector<WispContact>& out) {
+// with the same axial parameters: the bits and axial parameters of the first test in
+// bits 0-7 and axial[0, 8), those of the second in bits 8-15 and axial[8, 16).
+std::uint32_t masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t i1, std::size_t j1, std::size_t i2,
+                          std::size_t j2, float* axial) {
   const SegmentVolume &v1 = g.vol[j1], &v2 = g.vol[j2];
   const SegmentMasses &m1 = g.mass[i1], &m2 = g.mass[i2];
   auto add = [](__m512 a, __m512 b) { return _mm512_add_ps(a, b); };
@@ -214,99 +215,128 @@ void masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t i1, std:
   const std::uint32_t bits = _mm512_cmp_ps_mask(u, zero, _CMP_GE_OQ) &
                              _mm512_cmp_ps_mask(u, _mm512_set1_ps(1.0f), _CMP_LE_OQ) &
                              _mm512_cmp_ps_mask(f, _mm512_set1_ps(1.0f), _CMP_LT_OQ);
-  alignas(64) float axial[2 * SegmentMasses::kWidth];
   _mm512_store_ps(axial, u);
   constexpr std::uint32_t kHalf = (1u << kMassesPerSegment) - 1;
-  emit(g, i1, v1.a, bits & kHalf, axial, out);
-  emit(g, i2, v2.a, (bits >> SegmentMasses::kWidth) & kHalf, axial + SegmentMasses::kWidth, out);
+  return bits & (kHalf | kHalf << SegmentMasses::kWidth);
 }
 #else
-void masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t i1, std::size_t j1, std::size_t i2,
-                 std::size_t j2, std::vector<WispContact>& out) {
-  masses_in(g, s, i1, j1, out);
-  masses_in(g, s, i2, j2, out);
+std::uint32_t masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t i1, std::size_t j1, std::size_t i2,
+                          std::size_t j2, float* axial) {
+  constexpr int L = SegmentMasses::kWidth;
+  return masses_in(g, s, i1, j1, axial) | masses_in(g, s, i2, j2, axial + L) << L;
 }
 #endif
 
-// The full tests near_pair leaves, two at a time (masses_in_2), appended in the order
-// they were asked for.
-class FullTests {
- public:
-  FullTests(const SegmentGrid& g, const WispSystem& s, std::vector<WispContact>& out) : g_(g), s_(s), out_(out) {}
-  ~FullTests() {
-    if (pending_) masses_in(g_, s_, i_, j_, out_);
-  }
-  void add(std::size_t i, std::size_t j) {
-    if (pending_) {
-      masses_in_2(g_, s_, i_, j_, i, j, out_);
-    } else {
-      i_ = i;
-      j_ = j;
-    }
-    pending_ = !pending_;
-  }
-
- private:
-  const SegmentGrid& g_;
-  const WispSystem& s_;
-  std::vector<WispContact>& out_;
-  std::size_t i_ = 0, j_ = 0;
-  bool pending_ = false;
-};
-
 // Items [b, e) of a cell whose boxes meet [lo, hi] (compared as the original
-// (lo > hi).any() rejection, so NaN boxes are kept alike) and which are first met in
-// this cell: each axis of `past` (bit a where the cell lies past the tested segment's
-// cell_lo[a]) is set in their item_first (SegmentGrid::item_first). As bits from b on;
-// e - b <= 32.
+// (lo > hi).any() rejection, so NaN boxes are kept alike), which are first met in this
+// cell (each axis of `past`, bit a where the cell lies past the tested segment's
+// cell_lo[a], is set in their item_first: SegmentGrid::item_first) and whose segment is
+// `first_pair` or later. As bits from b on; e - b <= 32.
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+// 16 items per vector, the last ones by masked loads (issue 10: the scalar remainder of
+// the 8-lane loop GCC made was a fifth of the box tests' time; a cell's later items
+// number 26 on average on shake).
 std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e, const Vec3f& lo, const Vec3f& hi,
-                          std::uint8_t past) {
+                          std::uint8_t past, std::uint32_t first_pair) {
+  const __m512 lx = _mm512_set1_ps(lo.x()), ly = _mm512_set1_ps(lo.y()), lz = _mm512_set1_ps(lo.z());
+  const __m512 hx = _mm512_set1_ps(hi.x()), hy = _mm512_set1_ps(hi.y()), hz = _mm512_set1_ps(hi.z());
+  const __m512i want = _mm512_set1_epi32(past), from = _mm512_set1_epi32(static_cast<int>(first_pair));
+  std::uint32_t bits = 0;
+  for (std::uint32_t t = b; t < e; t += 16) {
+    const __mmask16 live = e - t >= 16 ? 0xffff : static_cast<__mmask16>((1u << (e - t)) - 1);
+    auto load = [&](const std::vector<float>& v) { return _mm512_maskz_loadu_ps(live, v.data() + t); };
+    // !(x > y) is true on NaN, as the scalar form: the quiet "not greater" predicate.
+    __mmask16 m = _mm512_mask_cmp_ps_mask(live, lx, load(g.item_hi[0]), _CMP_NGT_UQ);
+    m = _mm512_mask_cmp_ps_mask(m, load(g.item_lo[0]), hx, _CMP_NGT_UQ);
+    m = _mm512_mask_cmp_ps_mask(m, ly, load(g.item_hi[1]), _CMP_NGT_UQ);
+    m = _mm512_mask_cmp_ps_mask(m, load(g.item_lo[1]), hy, _CMP_NGT_UQ);
+    m = _mm512_mask_cmp_ps_mask(m, lz, load(g.item_hi[2]), _CMP_NGT_UQ);
+    m = _mm512_mask_cmp_ps_mask(m, load(g.item_lo[2]), hz, _CMP_NGT_UQ);
+    m = _mm512_mask_cmpge_epu32_mask(m, _mm512_maskz_loadu_epi32(live, g.cell_items.data() + t), from);
+    if (past != 0) {
+      const __m512i first = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(live, g.item_first.data() + t));
+      m = _mm512_mask_cmpeq_epi32_mask(m, _mm512_and_si512(first, want), want);
+    }
+    bits |= static_cast<std::uint32_t>(m) << (t - b);
+  }
+  return bits;
+}
+#else
+std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e, const Vec3f& lo, const Vec3f& hi,
+                          std::uint8_t past, std::uint32_t first_pair) {
   // Box tests into an array first (vector code), then gathered into bits.
   const float *lx = g.item_lo[0].data() + b, *ly = g.item_lo[1].data() + b, *lz = g.item_lo[2].data() + b;
   const float *hx = g.item_hi[0].data() + b, *hy = g.item_hi[1].data() + b, *hz = g.item_hi[2].data() + b;
   const std::uint8_t* first = g.item_first.data() + b;
+  const std::uint32_t* item = g.cell_items.data() + b;
   const std::uint32_t count = e - b;
   alignas(32) std::int32_t meet[32];
   for (std::uint32_t t = 0; t < count; ++t)
     meet[t] = !(lo.x() > hx[t]) & !(lx[t] > hi.x()) & !(lo.y() > hy[t]) & !(ly[t] > hi.y()) & !(lo.z() > hz[t]) &
-              !(lz[t] > hi.z()) & ((first[t] & past) == past);
+              !(lz[t] > hi.z()) & ((first[t] & past) == past) & (item[t] >= first_pair);
   std::uint32_t bits = 0;
   for (std::uint32_t t = 0; t < count; ++t) bits |= static_cast<std::uint32_t>(meet[t]) << t;
   return bits;
 }
+#endif
 
-// The pairs the box tests leave, tested kDepth pairs after their loads were started:
-// a pair's partner segment lies anywhere in memory, and near_pair's first use of its
-// volume waited on the load (issue 10: the hottest instruction of the narrow phase).
-// First in, first out: the pairs keep their order.
-class PairQueue {
+// The pairs the box tests leave, tested in batches, in order (issue 10). Their loads are
+// started as they are added: a pair's partner segment lies anywhere in memory. Then, per
+// batch: near_pair of every pair (independent, so their chains of vector operations
+// overlap; tested one at a time, each waited on the last one's branches), the full tests
+// they leave as a list (written without a branch: about a third of the directions go
+// either way), and those tests two at a time (masses_in_2). The contacts come out as
+// testing each pair in turn appends them: masses of i in j, then of j in i.
+class PairBatch {
  public:
-  PairQueue(const SegmentGrid& g, FullTests& full) : g_(g), full_(full) {}
-  ~PairQueue() {
-    while (head_ != tail_) test(ring_[head_++ % kDepth]);
-  }
+  PairBatch(const SegmentGrid& g, const WispSystem& s, std::vector<WispContact>& out) : g_(g), s_(s), out_(out) {}
+  ~PairBatch() { flush(); }
+  PairBatch(const PairBatch&) = delete;
+  PairBatch& operator=(const PairBatch&) = delete;
   void add(std::uint32_t i, std::uint32_t j) {
     __builtin_prefetch(&g_.vol[j]);
     __builtin_prefetch(&g_.mass[j]);
     __builtin_prefetch(reinterpret_cast<const char*>(&g_.mass[j]) + 64);
-    if (tail_ - head_ == kDepth) test(ring_[head_++ % kDepth]);
-    ring_[tail_++ % kDepth] = {i, j};
+    pairs_[count_++] = {i, j};
+    if (count_ == kBatch) flush();
   }
 
  private:
-  static constexpr std::uint32_t kDepth = 16;
+  static constexpr std::uint32_t kBatch = 128;
   struct Pair {
     std::uint32_t i, j;
   };
-  void test(Pair p) {
-    const std::uint32_t near = near_pair(g_, p.i, p.j);
-    if ((near & 0xff) != 0) full_.add(p.i, p.j);
-    if ((near >> 8) != 0) full_.add(p.j, p.i);
+  void flush() {
+    for (std::uint32_t k = 0; k < count_; ++k) near_[k] = near_pair(g_, pairs_[k].i, pairs_[k].j);
+    std::uint32_t n = 0;
+    for (std::uint32_t k = 0; k < count_; ++k) {
+      full_[n] = pairs_[k];
+      n += (near_[k] & 0xff) != 0;
+      full_[n] = {pairs_[k].j, pairs_[k].i};
+      n += (near_[k] >> 8) != 0;
+    }
+    constexpr int L = SegmentMasses::kWidth;
+    for (std::uint32_t t = 0; t + 1 < n; t += 2) {
+      const Pair a = full_[t], b = full_[t + 1];
+      const std::uint32_t bits = masses_in_2(g_, s_, a.i, a.j, b.i, b.j, &axial_[t][0]);
+      inside_[t] = bits & ((1u << L) - 1);
+      inside_[t + 1] = bits >> L;
+    }
+    if (n % 2 != 0) inside_[n - 1] = masses_in(g_, s_, full_[n - 1].i, full_[n - 1].j, &axial_[n - 1][0]);
+    for (std::uint32_t t = 0; t < n; ++t) emit(g_, full_[t].i, g_.seg[full_[t].j], inside_[t], &axial_[t][0], out_);
+    count_ = 0;
   }
   const SegmentGrid& g_;
-  FullTests& full_;
-  Pair ring_[kDepth];
-  std::uint32_t head_ = 0, tail_ = 0;
+  const WispSystem& s_;
+  std::vector<WispContact>& out_;
+  std::uint32_t count_ = 0;
+  Pair pairs_[kBatch];
+  std::uint32_t near_[kBatch];
+  Pair full_[2 * kBatch + 1];
+  // Per full test: its masses inside, and their axial parameters (masses_in_2 writes two
+  // tests' lanes at once).
+  std::uint32_t inside_[2 * kBatch + 1];
+  alignas(64) float axial_[2 * kBatch + 2][SegmentMasses::kWidth];
 };
 
 }  // namespace
@@ -314,10 +344,16 @@ class PairQueue {
 void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
               std::vector<WispContact>& out) {
   auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
-  FullTests full(g, s, out);
-  PairQueue pairs(g, full);  // flushed before `full`
+  PairBatch pairs(g, s, out);
   for (std::size_t i = begin; i < end; ++i) {
     const auto i32 = static_cast<std::uint32_t>(i);
+    // Segments less than three apart along a wisp are no pair. A wisp's segments are
+    // consecutive in seg, so these are the ones after i up to its wisp's end: the later
+    // segments j of i's cells pair with it from first_pair on, which the box tests check
+    // (issue 10: checking wisp[j] per pair left, it put the load of j on the path of the
+    // next pair's).
+    std::uint32_t first_pair = i32 + 1;
+    while (first_pair < i32 + 3 && first_pair < g.size() && g.wisp[first_pair] == g.wisp[i]) ++first_pair;
     const Eigen::Vector3i& lo = g.cell_lo[i];
     const std::uint32_t* self = g.self_items.data() + g.self_begin[i];
     for (int z = lo.z(); z <= g.cell_hi[i].z(); ++z)
@@ -325,19 +361,14 @@ void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std:
         for (int x = lo.x(); x <= g.cell_hi[i].x(); ++x) {
           const std::uint32_t stop = g.cell_start[index(x, y, z) + 1];
           const auto past = static_cast<std::uint8_t>((x != lo.x()) | (y != lo.y()) << 1 | (z != lo.z()) << 2);
-          // A cell's items ascend: the later segments follow i's own entry. The box and
-          // first-cell tests over a run of items at once; the wisp and narrow-phase tests
+          // A cell's items ascend: the later segments follow i's own entry. The box,
+          // first-cell and wisp tests over a run of items at once; the narrow-phase tests
           // then for the pairs left, in item order: the same pairs in the same order as
           // testing each item in turn with a mailbox (grid_contacts_ref).
           for (std::uint32_t it = *self++ + 1; it < stop; it += 32) {
-            for (std::uint32_t bits = overlapping(g, it, std::min(stop, it + 32), g.lo[i], g.hi[i], past); bits != 0;
-                 bits &= bits - 1) {
-              const std::uint32_t j = g.cell_items[it + static_cast<std::uint32_t>(std::countr_zero(bits))];
-              // Later within a wisp: a wisp's segments are consecutive in seg, so j - i
-              // is seg[j] - seg[i] there, and only the nearest need the wisp looked up.
-              if (j - i32 < 3 && g.wisp[j] == g.wisp[i]) continue;
-              pairs.add(i32, j);
-            }
+            std::uint32_t bits = overlapping(g, it, std::min(stop, it + 32), g.lo[i], g.hi[i], past, first_pair);
+            for (; bits != 0; bits &= bits - 1)
+              pairs.add(i32, g.cell_items[it + static_cast<std::uint32_t>(std::countr_zero(bits))]);
           }
         }
   }
