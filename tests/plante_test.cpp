@@ -1,6 +1,7 @@
 // Properties Plante, Cani & Poulin 2001 claims for the layered wisp model (§3-§5),
 // checked on hand-built wisp pairs and on the built-in scenarios.
 #include "kernels/cpu/vec_math.h"
+#include "kernels/cpu/wisp_grid.h"
 #include "kernels/cpu/wisp_soa.h"
 #include "models/plante_wisp/model.h"
 #include "models/plante_wisp/settings.h"
@@ -429,6 +430,44 @@ TEST(PlanteWisp, BodyBlockKernelsAgreeWhereMassesStartInside) {
     ASSERT_EQ(metrics::state_hash(fast.positions()), metrics::state_hash(ref.positions())) << "frame " << f;
   }
   EXPECT_GT(listed, 0u) << "no body contact listed: the sliding and holding lanes were not reached";
+}
+
+// Issue 10: the broad phase's grid built in parts (grid_frame, grid_count, grid_offsets,
+// grid_fill: what plante_wisp runs on its threads) is the grid grid_cells builds, entry
+// for entry, for any number of parts, on a shaken state with segments in every cell.
+TEST(PlanteWisp, GridInPartsIsTheSerialGrid) {
+  const Scenario sc = builtin("shake", 8);
+  plante::PlanteWispModel m(ModelContext{nullptr});
+  m.reset(sc.groom, plante_params(sc.groom));
+  for (int f = 0; f < 20; ++f) {
+    StageTimes t;
+    m.step(frame_input(sc, f), t);
+  }
+  kernels::SegmentGrid serial;
+  kernels::grid_build(serial, m.wisps());
+  ASSERT_GT(serial.cell_items.size(), serial.size());
+  for (std::size_t parts : {2, 3, 7}) {
+    kernels::SegmentGrid g;
+    kernels::grid_segments(g, m.wisps());
+    kernels::grid_setup(g, m.wisps(), 0, g.size());
+    kernels::grid_frame(g, parts);
+    ASSERT_EQ(g.part_begin.size(), parts + 1);
+    // The parts in reverse order: no part depends on another's having run first.
+    for (std::size_t p = parts; p-- > 0;) kernels::grid_count(g, p);
+    kernels::grid_offsets(g);
+    for (std::size_t p = parts; p-- > 0;) kernels::grid_fill(g, p);
+    EXPECT_EQ(g.dims, serial.dims) << parts;
+    EXPECT_EQ(g.cell_start, serial.cell_start) << parts;
+    EXPECT_EQ(g.cell_items, serial.cell_items) << parts;
+    EXPECT_EQ(g.item_first, serial.item_first) << parts;
+    EXPECT_EQ(g.self_begin, serial.self_begin) << parts;
+    EXPECT_EQ(g.self_items, serial.self_items) << parts;
+    EXPECT_EQ(g.candidates, serial.candidates) << parts;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(g.item_lo[a], serial.item_lo[a]) << parts;
+      EXPECT_EQ(g.item_hi[a], serial.item_hi[a]) << parts;
+    }
+  }
 }
 
 // The bending springs' angle (kernels::atan2_upper) against libm's atan2 in double, in

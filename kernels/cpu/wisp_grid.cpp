@@ -35,7 +35,7 @@ void grid_segments(SegmentGrid& g, const WispSystem& s) {
   g.hi.resize(n);
   g.cell_lo.resize(n);
   g.cell_hi.resize(n);
-  g.candidates.assign(n, 0);
+  g.candidates.resize(n);
 }
 
 void grid_setup(SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end) {
@@ -68,11 +68,31 @@ void grid_build(SegmentGrid& g, const WispSystem& s) {
 }
 
 void grid_cells(SegmentGrid& g) {
+  grid_frame(g, 1);
+  grid_count(g, 0);
+  grid_offsets(g);
+  grid_fill(g, 0);
+}
+
+namespace {
+
+std::size_t cell_index(const SegmentGrid& g, int x, int y, int z) {
+  return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x;
+}
+
+}  // namespace
+
+void grid_frame(SegmentGrid& g, std::size_t parts) {
   const std::size_t n = g.size();
+  parts = std::max<std::size_t>(1, std::min(parts, n));
+  g.part_begin.resize(parts + 1);
+  for (std::size_t p = 0; p <= parts; ++p) g.part_begin[p] = n * p / parts;
+  g.part_cells.resize(parts);
+  g.part_items.assign(parts + 1, 0);
   if (n == 0) {
-    g.cell_start.assign(2, 0);
-    g.cell_items.clear();
     g.dims = Eigen::Vector3i::Ones();
+    g.cell_start.assign(2, 0);
+    g.part_cells[0].assign(1, 0);
     return;
   }
   // In segment order, whichever threads set the segments up (min and max keep a NaN or
@@ -89,23 +109,53 @@ void grid_cells(SegmentGrid& g) {
   g.origin = all_lo;
   for (int a = 0; a < 3; ++a)
     g.dims[a] = std::clamp(static_cast<int>((all_hi[a] - all_lo[a]) / g.cell) + 1, 1, kMaxGridCells + 1);
+  const std::size_t cells = static_cast<std::size_t>(g.dims.x()) * g.dims.y() * g.dims.z();
+  g.cell_start.resize(cells + 1);
+  for (auto& counts : g.part_cells) counts.assign(cells, 0);
+}
+
+void grid_count(SegmentGrid& g, std::size_t part) {
+  if (g.size() == 0) return;
   auto cell_of = [&](const Vec3f& p) {
     Eigen::Vector3i c;
     for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - g.origin[a]) / g.cell), 0, g.dims[a] - 1);
     return c;
   };
-  const std::size_t cells = static_cast<std::size_t>(g.dims.x()) * g.dims.y() * g.dims.z();
-  g.cell_start.assign(cells + 1, 0);
-  auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::uint32_t>& counts = g.part_cells[part];
+  std::uint32_t items = 0;
+  for (std::size_t i = g.part_begin[part]; i < g.part_begin[part + 1]; ++i) {
     g.cell_lo[i] = cell_of(g.lo[i]);
     g.cell_hi[i] = cell_of(g.hi[i]);
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) ++g.cell_start[index(x, y, z) + 1];
+        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+          ++counts[cell_index(g, x, y, z)];
+          ++items;
+        }
   }
-  for (std::size_t c = 0; c < cells; ++c) g.cell_start[c + 1] += g.cell_start[c];
-  const std::size_t items = g.cell_start[cells];
+  g.part_items[part + 1] = items;
+}
+
+void grid_offsets(SegmentGrid& g) {
+  const std::size_t n = g.size(), cells = g.cell_start.size() - 1, parts = g.part_cells.size();
+  if (n == 0) {
+    g.cell_items.clear();
+    return;
+  }
+  // Cell c's items: those of part 0, then part 1, ...; so each part's counts become the
+  // slot of its first item in the cell, and the cell's items ascend.
+  std::uint32_t slot = 0;
+  for (std::size_t c = 0; c < cells; ++c) {
+    g.cell_start[c] = slot;
+    for (std::size_t p = 0; p < parts; ++p) {
+      const std::uint32_t count = g.part_cells[p][c];
+      g.part_cells[p][c] = slot;
+      slot += count;
+    }
+  }
+  g.cell_start[cells] = slot;
+  for (std::size_t p = 0; p < parts; ++p) g.part_items[p + 1] += g.part_items[p];
+  const std::size_t items = slot;
   g.cell_items.resize(items);
   for (int a = 0; a < 3; ++a) {
     g.item_lo[a].resize(items);
@@ -113,16 +163,23 @@ void grid_cells(SegmentGrid& g) {
   }
   g.item_first.resize(items);
   g.self_begin.resize(n + 1);
+  g.self_begin[n] = static_cast<std::uint32_t>(items);
   g.self_items.resize(items);
-  g.cell_fill.assign(g.cell_start.begin(), g.cell_start.end() - 1);
-  std::uint32_t slot = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+}
+
+void grid_fill(SegmentGrid& g, std::size_t part) {
+  if (g.size() == 0) return;
+  std::vector<std::uint32_t>& fill = g.part_cells[part];
+  std::uint32_t slot = g.part_items[part];
+  for (std::size_t i = g.part_begin[part]; i < g.part_begin[part + 1]; ++i) {
     const Eigen::Vector3i& lo = g.cell_lo[i];
     g.self_begin[i] = slot;
+    g.candidates[i] = 0;
     for (int z = lo.z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = lo.y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = lo.x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::uint32_t it = g.cell_fill[index(x, y, z)]++;
+          const std::size_t c = cell_index(g, x, y, z);
+          const std::uint32_t it = fill[c]++;
           g.cell_items[it] = static_cast<std::uint32_t>(i);
           for (int a = 0; a < 3; ++a) {
             g.item_lo[a][it] = g.lo[i][a];
@@ -131,10 +188,9 @@ void grid_cells(SegmentGrid& g) {
           g.item_first[it] = static_cast<std::uint8_t>((x == lo.x()) | (y == lo.y()) << 1 | (z == lo.z()) << 2);
           g.self_items[slot++] = it;
           // A cell's items ascend (filled in segment order): the rest after it are later.
-          g.candidates[i] += g.cell_start[index(x, y, z) + 1] - it - 1;
+          g.candidates[i] += g.cell_start[c + 1] - it - 1;
         }
   }
-  g.self_begin[n] = slot;
 }
 
 void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t>& bounds) {

@@ -55,7 +55,12 @@ struct SegmentGrid {
   // CSR: per segment, its own entry in each of its cells, in z, y, x order (the later
   // segments of a cell follow it there).
   std::vector<std::uint32_t> self_begin, self_items;
-  std::vector<std::uint32_t> cell_fill;  // scratch of grid_build
+  // Scratch of the grid's parts (grid_frame): part p is segments [part_begin[p],
+  // part_begin[p + 1]); its items per cell (grid_count), then the slot of its next one in
+  // each cell (grid_offsets, grid_fill); part_items[p]: its first entry of self_items.
+  std::vector<std::size_t> part_begin;
+  std::vector<std::vector<std::uint32_t>> part_cells;
+  std::vector<std::uint32_t> part_items;
   // Per segment, its candidates: the later segments in its cells, summed over the cells.
   // The narrow phase of segment i costs about that much, and it falls the more the later
   // i is, so equal ranges of segments are far from equal work (issue 10: grid_split).
@@ -78,6 +83,14 @@ void grid_segments(SegmentGrid& g, const WispSystem& s);
 void grid_setup(SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end);
 // The cells, from the segments' boxes, and each segment's candidates.
 void grid_cells(SegmentGrid& g);
+// grid_cells in steps, so that its loops over the segments can run on several threads
+// (issue 10): grid_frame (the cells from the boxes' bounds, and `parts` equal ranges of
+// segments), grid_count of every part, grid_offsets, then grid_fill of every part. Any
+// number of parts gives the same grid.
+void grid_frame(SegmentGrid& g, std::size_t parts);
+void grid_count(SegmentGrid& g, std::size_t part);
+void grid_offsets(SegmentGrid& g);
+void grid_fill(SegmentGrid& g, std::size_t part);
 
 // The narrow phase as first written (plante_wisp_ref; issue 10 keeps it as the reference
 // of wisp_soa's ContactsFn, which finds the same contacts in the same order): for each
