@@ -58,9 +58,12 @@ inline void rotate(float qx, float qy, float qz, float qw, float vx, float vy, f
   oz = vz + qw * uz + (qx * uy - qy * ux);
 }
 
-// GCC 12 warns that _mm512_sqrt_ps's internal undefined operand may be uninitialised
-// wherever it is inlined; a false positive (as in soa_rows.h).
+// GCC 12 warns that _mm512_sqrt_ps's internal undefined operand is or may be
+// uninitialised wherever it is inlined; a false positive (as in soa_rows.h). The rows
+// and frames here are read and written with unaligned loads and stores: Quat and the
+// block's rows are not declared 64-byte aligned.
 #pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 // The frame of vertex i from its parent's frame and the edge (a, b): Algorithm 3, lines
 // 10-12, as kernels::child_frame (strand_kernels.cpp) with rotation_from_x (frames.h).
@@ -97,18 +100,19 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
   // be parent); as intrinsics, every store is whole (issue 10; model 1 groom, one
   // thread: method 1 5.71-5.73 -> 5.44-5.63 ms, method 2 9.47-9.49 -> 8.84-8.85 ms).
   const __m512 zero = _mm512_setzero_ps();
-  const __m512 mx = _mm512_load_ps(m.x), my = _mm512_load_ps(m.y), mz = _mm512_load_ps(m.z), mw = _mm512_load_ps(m.w);
+  const __m512 mx = _mm512_loadu_ps(m.x), my = _mm512_loadu_ps(m.y);
+  const __m512 mz = _mm512_loadu_ps(m.z), mw = _mm512_loadu_ps(m.w);
   const __m512 n2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(mx, mx), _mm512_mul_ps(mz, mz)),
                                   _mm512_add_ps(_mm512_mul_ps(my, my), _mm512_mul_ps(mw, mw)));
   const __m512 rn = _mm512_sqrt_ps(n2);
   const __mmask16 scale = _mm512_cmp_ps_mask(n2, zero, _CMP_GT_OQ);
-  const __mmask16 keep = _mm512_cmp_ps_mask(_mm512_load_ps(ok), zero, _CMP_EQ_OQ);
-  const __m512 px = _mm512_load_ps(parent.x), py = _mm512_load_ps(parent.y), pz = _mm512_load_ps(parent.z);
-  const __m512 pw = _mm512_load_ps(parent.w);
-  _mm512_store_ps(out.x, _mm512_mask_mov_ps(_mm512_mask_div_ps(mx, scale, mx, rn), keep, px));
-  _mm512_store_ps(out.y, _mm512_mask_mov_ps(_mm512_mask_div_ps(my, scale, my, rn), keep, py));
-  _mm512_store_ps(out.z, _mm512_mask_mov_ps(_mm512_mask_div_ps(mz, scale, mz, rn), keep, pz));
-  _mm512_store_ps(out.w, _mm512_mask_mov_ps(_mm512_mask_div_ps(mw, scale, mw, rn), keep, pw));
+  const __mmask16 keep = _mm512_cmp_ps_mask(_mm512_loadu_ps(ok), zero, _CMP_EQ_OQ);
+  const __m512 px = _mm512_loadu_ps(parent.x), py = _mm512_loadu_ps(parent.y), pz = _mm512_loadu_ps(parent.z);
+  const __m512 pw = _mm512_loadu_ps(parent.w);
+  _mm512_storeu_ps(out.x, _mm512_mask_mov_ps(_mm512_mask_div_ps(mx, scale, mx, rn), keep, px));
+  _mm512_storeu_ps(out.y, _mm512_mask_mov_ps(_mm512_mask_div_ps(my, scale, my, rn), keep, py));
+  _mm512_storeu_ps(out.z, _mm512_mask_mov_ps(_mm512_mask_div_ps(mz, scale, mz, rn), keep, pz));
+  _mm512_storeu_ps(out.w, _mm512_mask_mov_ps(_mm512_mask_div_ps(mw, scale, mw, rn), keep, pw));
 #else
   LANES {
     const float n2 = (m.x[l] * m.x[l] + m.z[l] * m.z[l]) + (m.y[l] * m.y[l] + m.w[l] * m.w[l]);
@@ -136,14 +140,14 @@ inline void local_edge(float* __restrict ax, float* __restrict ay, float* __rest
                        const float* ka, const float* kb, const float* gx, const float* gy, const float* gz,
                        float stiffness) {
 #if defined(__AVX512F__)
-  const __mmask16 on = _mm512_cmp_ps_mask(_mm512_add_ps(_mm512_load_ps(aw), _mm512_load_ps(bw)), _mm512_setzero_ps(),
-                                          _CMP_NEQ_UQ);
-  const __m512 k = _mm512_set1_ps(stiffness), wa = _mm512_load_ps(ka), wb = _mm512_load_ps(kb);
+  const __m512 wsum = _mm512_add_ps(_mm512_loadu_ps(aw), _mm512_loadu_ps(bw));
+  const __mmask16 on = _mm512_cmp_ps_mask(wsum, _mm512_setzero_ps(), _CMP_NEQ_UQ);
+  const __m512 k = _mm512_set1_ps(stiffness), wa = _mm512_loadu_ps(ka), wb = _mm512_loadu_ps(kb);
   auto axis = [&](float* a, float* b, const float* g) {
-    const __m512 va = _mm512_load_ps(a), vb = _mm512_load_ps(b);
-    const __m512 d = _mm512_mul_ps(k, _mm512_sub_ps(_mm512_load_ps(g), vb));
-    _mm512_store_ps(a, _mm512_mask_sub_ps(va, on, va, _mm512_mul_ps(d, wa)));
-    _mm512_store_ps(b, _mm512_mask_add_ps(vb, on, vb, _mm512_mul_ps(d, wb)));
+    const __m512 va = _mm512_loadu_ps(a), vb = _mm512_loadu_ps(b);
+    const __m512 d = _mm512_mul_ps(k, _mm512_sub_ps(_mm512_loadu_ps(g), vb));
+    _mm512_storeu_ps(a, _mm512_mask_sub_ps(va, on, va, _mm512_mul_ps(d, wa)));
+    _mm512_storeu_ps(b, _mm512_mask_add_ps(vb, on, vb, _mm512_mul_ps(d, wb)));
   };
   axis(ax, bx, gx);
   axis(ay, by, gy);
