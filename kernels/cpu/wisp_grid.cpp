@@ -74,14 +74,6 @@ void grid_cells(SegmentGrid& g) {
   grid_fill(g, 0);
 }
 
-namespace {
-
-std::size_t cell_index(const SegmentGrid& g, int x, int y, int z) {
-  return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x;
-}
-
-}  // namespace
-
 void grid_frame(SegmentGrid& g, std::size_t parts) {
   const std::size_t n = g.size();
   parts = std::max<std::size_t>(1, std::min(parts, n));
@@ -92,7 +84,6 @@ void grid_frame(SegmentGrid& g, std::size_t parts) {
   if (n == 0) {
     g.dims = Eigen::Vector3i::Ones();
     g.cell_start.assign(2, 0);
-    g.part_cells[0].assign(1, 0);
     return;
   }
   // In segment order, whichever threads set the segments up (min and max keep a NaN or
@@ -129,7 +120,7 @@ void grid_count(SegmentGrid& g, std::size_t part) {
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
-          ++counts[cell_index(g, x, y, z)];
+          ++counts[g.cell_at(x, y, z)];
           ++items;
         }
   }
@@ -178,7 +169,7 @@ void grid_fill(SegmentGrid& g, std::size_t part) {
     for (int z = lo.z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = lo.y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = lo.x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::size_t c = cell_index(g, x, y, z);
+          const std::size_t c = g.cell_at(x, y, z);
           const std::uint32_t it = fill[c]++;
           g.cell_items[it] = static_cast<std::uint32_t>(i);
           for (int a = 0; a < 3; ++a) {
@@ -227,13 +218,12 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
 
 void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                        std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
-  auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
   for (std::size_t i = begin; i < end; ++i) {
     const std::uint32_t a = g.seg[i];
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::size_t c = index(x, y, z);
+          const std::size_t c = g.cell_at(x, y, z);
           for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it) {
             const std::uint32_t j = g.cell_items[it];
             if (j <= i || mailbox[j] == i) continue;

@@ -67,6 +67,8 @@ struct SegmentGrid {
   std::vector<std::uint32_t> candidates;
 
   std::size_t size() const { return seg.size(); }
+  // The index of cell (x, y, z) in cell_start.
+  std::size_t cell_at(int x, int y, int z) const { return (static_cast<std::size_t>(z) * dims.y() + y) * dims.x() + x; }
 };
 
 // The cells are cubes as wide as the widest segment box, so a box covers at most 2x2x2

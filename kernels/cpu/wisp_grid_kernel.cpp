@@ -335,15 +335,14 @@ class PairBatch {
   Pair full_[2 * kBatch + 1];
   // Per full test: its masses inside, and their axial parameters (masses_in_2 writes two
   // tests' lanes at once).
-  std::uint32_t inside_[2 * kBatch + 1];
-  alignas(64) float axial_[2 * kBatch + 2][SegmentMasses::kWidth];
+  std::uint32_t inside_[2 * kBatch];
+  alignas(64) float axial_[2 * kBatch][SegmentMasses::kWidth];
 };
 
 }  // namespace
 
 void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
               std::vector<WispContact>& out) {
-  auto index = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * g.dims.y() + y) * g.dims.x() + x; };
   PairBatch pairs(g, s, out);
   for (std::size_t i = begin; i < end; ++i) {
     const auto i32 = static_cast<std::uint32_t>(i);
@@ -359,7 +358,7 @@ void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std:
     for (int z = lo.z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = lo.y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = lo.x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::uint32_t stop = g.cell_start[index(x, y, z) + 1];
+          const std::uint32_t stop = g.cell_start[g.cell_at(x, y, z) + 1];
           const auto past = static_cast<std::uint8_t>((x != lo.x()) | (y != lo.y()) << 1 | (z != lo.z()) << 2);
           // A cell's items ascend: the later segments follow i's own entry. The box,
           // first-cell and wisp tests over a run of items at once; the narrow-phase tests
