@@ -129,6 +129,21 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
 }
 #pragma GCC diagnostic pop
 
+// Eq. 4 (local_shape_edge) on one lane's values: a and b move towards goal g by their
+// mass weights ka, kb (mass_weights), where `on` (not both pinned).
+inline void local_lane(float& ax, float& ay, float& az, float& bx, float& by, float& bz, bool on, float ka, float kb,
+                       float gx, float gy, float gz, float stiffness) {
+  const float dx = stiffness * (gx - bx), dy = stiffness * (gy - by), dz = stiffness * (gz - bz);
+  const float nax = ax - dx * ka, nay = ay - dy * ka, naz = az - dz * ka;
+  const float nbx = bx + dx * kb, nby = by + dy * kb, nbz = bz + dz * kb;
+  ax = on ? nax : ax;
+  ay = on ? nay : ay;
+  az = on ? naz : az;
+  bx = on ? nbx : bx;
+  by = on ? nby : by;
+  bz = on ? nbz : bz;
+}
+
 // The local shape constraint of edge (a, b) towards goal (Eq. 4, local_shape_edge).
 // ka, kb: the edge's mass weights (mass_weights). With AVX-512 the select of the lanes
 // that move is a masked operation on the full row, stored whole (issue 10): as GCC wrote
@@ -154,14 +169,14 @@ inline void local_edge(float* __restrict ax, float* __restrict ay, float* __rest
   axis(az, bz, gz);
 #else
   LANES {
-    const bool on = aw[l] + bw[l] != 0.0f;
-    const float dx = stiffness * (gx[l] - bx[l]), dy = stiffness * (gy[l] - by[l]), dz = stiffness * (gz[l] - bz[l]);
-    ax[l] = on ? ax[l] - dx * ka[l] : ax[l];
-    ay[l] = on ? ay[l] - dy * ka[l] : ay[l];
-    az[l] = on ? az[l] - dz * ka[l] : az[l];
-    bx[l] = on ? bx[l] + dx * kb[l] : bx[l];
-    by[l] = on ? by[l] + dy * kb[l] : by[l];
-    bz[l] = on ? bz[l] + dz * kb[l] : bz[l];
+    float x0 = ax[l], y0 = ay[l], z0 = az[l], x1 = bx[l], y1 = by[l], z1 = bz[l];
+    local_lane(x0, y0, z0, x1, y1, z1, aw[l] + bw[l] != 0.0f, ka[l], kb[l], gx[l], gy[l], gz[l], stiffness);
+    ax[l] = x0;
+    ay[l] = y0;
+    az[l] = z0;
+    bx[l] = x1;
+    by[l] = y1;
+    bz[l] = z1;
   }
 #endif
 }
@@ -240,56 +255,65 @@ inline void integrate_row(const Rows& r, int i, const soa::AffinePose& h, const 
   }
 }
 
+// Eq. 2 (global_shape) on row i: free vertices below reach move towards T_H · P_i^0. The
+// pose is taken by value, as in follow_head_row.
+inline void global_row(const Rows& r, RowKind kind, int i, const soa::AffinePose h, const BlockParams& p) {
+  if (kind == kRowPinned || !(static_cast<float>(i) < p.global_reach)) return;
+  const int o = i * W;
+  float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+  const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
+  const float k = p.global_ramp ? p.global_stiffness * (1.0f - static_cast<float>(i) / p.global_reach)
+                                : p.global_stiffness;
+  // A free row moves every lane, with no test: with the test GCC 12 leaves this loop
+  // scalar (the select becomes a branch per lane).
+  if (kind == kRowFree) {
+    LANES {
+      const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
+      px[l] = px[l] + k * (gx - px[l]);
+      py[l] = py[l] + k * (gy - py[l]);
+      pz[l] = pz[l] + k * (gz - pz[l]);
+    }
+    return;
+  }
+  LANES {
+    const bool on = iw[l] != 0.0f;
+    const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
+    px[l] = on ? px[l] + k * (gx - px[l]) : px[l];
+    py[l] = on ? py[l] + k * (gy - py[l]) : py[l];
+    pz[l] = on ? pz[l] + k * (gz - pz[l]) : pz[l];
+  }
+}
+
 // Pinned vertices follow the head (follow_head), free ones are Verlet-integrated
 // (verlet_integrate); row by row, so the wind term sees vertex i-1 already moved, as in
-// the per-strand kernel.
-template <bool kWindy>
-void integrate(const Rows& r, const RowKind* kinds, int n, const Substep& s, const Frame& f, float keep) {
+// the per-strand kernel. With kGlobal, the global shape constraint (global_row) follows
+// one row behind, while the rows are still in L1 and registers: row i-1 once row i, the
+// last to read it, has been integrated. The same bits as the two stages one after the
+// other (issue 10).
+template <bool kWindy, bool kGlobal>
+void integrate(const Rows& r, const RowKind* kinds, int n, const Substep& s, const Frame& f, const BlockParams& p) {
   const soa::AffinePose h(s.m, s.t);
   for (int i = 0; i < n; ++i) {
     switch (kinds[i]) {
       case kRowFree:
-        integrate_row<kWindy, kRowFree>(r, i, h, s, f, keep);
+        integrate_row<kWindy, kRowFree>(r, i, h, s, f, p.keep);
         break;
       case kRowPinned:
-        integrate_row<kWindy, kRowPinned>(r, i, h, s, f, keep);
+        integrate_row<kWindy, kRowPinned>(r, i, h, s, f, p.keep);
         break;
       default:
-        integrate_row<kWindy, kRowMixed>(r, i, h, s, f, keep);
+        integrate_row<kWindy, kRowMixed>(r, i, h, s, f, p.keep);
         break;
     }
+    if (kGlobal && i > 0) global_row(r, kinds[i - 1], i - 1, h, p);
   }
+  if (kGlobal && n > 0) global_row(r, kinds[n - 1], n - 1, h, p);
 }
 
-// Eq. 2 (global_shape): free vertices below reach move towards T_H · P_i^0.
+// Eq. 2 as a stage of its own (the blocks that time their stages).
 void global_shape(const Rows& r, const RowKind* kinds, int n, const Substep& s, const BlockParams& p) {
   const soa::AffinePose h(s.m, s.t);
-  for (int i = 0; i < n && static_cast<float>(i) < p.global_reach; ++i) {
-    if (kinds[i] == kRowPinned) continue;
-    const int o = i * W;
-    float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
-    const float *iw = r.iw + o, *rx = r.rx + o, *ry = r.ry + o, *rz = r.rz + o;
-    const float k = p.global_ramp ? p.global_stiffness * (1.0f - static_cast<float>(i) / p.global_reach)
-                                  : p.global_stiffness;
-    // A free row moves every lane, with no test: with the test GCC 12 leaves this loop
-    // scalar (the select becomes a branch per lane).
-    if (kinds[i] == kRowFree) {
-      LANES {
-        const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
-        px[l] = px[l] + k * (gx - px[l]);
-        py[l] = py[l] + k * (gy - py[l]);
-        pz[l] = pz[l] + k * (gz - pz[l]);
-      }
-      continue;
-    }
-    LANES {
-      const bool on = iw[l] != 0.0f;
-      const float gx = h.x(rx[l], ry[l], rz[l]), gy = h.y(rx[l], ry[l], rz[l]), gz = h.z(rx[l], ry[l], rz[l]);
-      px[l] = on ? px[l] + k * (gx - px[l]) : px[l];
-      py[l] = on ? py[l] + k * (gy - py[l]) : py[l];
-      pz[l] = on ? pz[l] + k * (gz - pz[l]) : pz[l];
-    }
-  }
+  for (int i = 0; i < n; ++i) global_row(r, kinds[i], i, h, p);
 }
 
 // The local constraint's mass weights w_{i-1}/(w_{i-1}+w_i) and w_i/(w_{i-1}+w_i) of
@@ -317,21 +341,146 @@ void rest_edges_m3(const Rows& r, int n, const Substep& s, float* ex, float* ey,
   }
 }
 
-// ...then every iteration's goals are P_{i-1} + that edge, in even/odd batches (§5).
-void local_m3(const Rows& r, int n, const float* ex, const float* ey, const float* ez, const float* ka,
-              const float* kb, float stiffness) {
-  alignas(64) float gx[W], gy[W], gz[W];
-  for (int first : {2, 3})
-    for (int i = first; i < n; i += 2) {
-      const int a = (i - 1) * W, b = i * W;
-      LANES {
-        gx[l] = r.px[a + l] + ex[b + l];
-        gy[l] = r.py[a + l] + ey[b + l];
-        gz[l] = r.pz[a + l] + ez[b + l];
-      }
-      local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, ka + b, kb + b, gx, gy, gz,
-                 stiffness);
+// ...then every iteration's goals are P_{i-1} + that edge, in even/odd batches (§5): see
+// edge_pass below.
+struct LocalRows {
+  const float *ex, *ey, *ez;  // the rest edges of rest_edges_m3
+  const float *ka, *kb;       // mass_weights
+  float stiffness;
+};
+
+// The edge length constraint (edge_length) of an edge (a, b), on one lane's values.
+inline void length_lane(float& ax, float& ay, float& az, float& bx, float& by, float& bz, float aw, float bw,
+                        float rl) {
+  const float wsum = aw + bw;
+  const float dx = bx - ax, dy = by - ay, dz = bz - az;
+  const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
+  const bool on = wsum != 0.0f && len > 0.0f;
+  const float k = (len - rl) / (len * wsum);
+  const float cx = dx * k, cy = dy * k, cz = dz * k;
+  const float nax = ax + aw * cx, nay = ay + aw * cy, naz = az + aw * cz;
+  const float nbx = bx - bw * cx, nby = by - bw * cy, nbz = bz - bw * cz;
+  ax = on ? nax : ax;
+  ay = on ? nay : ay;
+  az = on ? naz : az;
+  bx = on ? nbx : bx;
+  by = on ? nby : by;
+  bz = on ? nbz : bz;
+}
+
+// A pass over the edges (i-1, i), i = first, first + 2, ... < n: the local constraint of
+// method 3 (Algorithm 5's even/odd batches; its edges start at i = 2) or the length
+// constraint (its edges start at i = 1), or both, one after the other on each edge.
+// Algorithm 1 alternates local and length iterations, each an even and an odd batch:
+// local i = 2, 4, ... then 3, 5, ...; length 1, 3, ... then 2, 4, .... The last batch of
+// one iteration and the first of the next take the same pairs of vertices, and the pairs
+// of a batch are disjoint, so applying both constraints to a pair before moving to the
+// next gives every constraint the positions it had batch by batch: the same bits, with
+// the pair loaded and stored once instead of twice (issue 10).
+enum class EdgeOp : std::uint8_t { kNone, kLocal, kLength };
+
+// The rows one edge reads and writes, as restrict pointers, so that the compiler need
+// not assume a store to a position may change the weights or rest edges.
+struct EdgeRowPtrs {
+  float *__restrict ax, *__restrict ay, *__restrict az, *__restrict bx, *__restrict by, *__restrict bz;
+  const float *__restrict aw, *__restrict bw, *__restrict rl, *__restrict ka, *__restrict kb, *__restrict ex,
+      *__restrict ey, *__restrict ez;
+};
+
+template <EdgeOp kOp>
+inline void apply_edge(float& ax, float& ay, float& az, float& bx, float& by, float& bz, float aw, float bw,
+                       const EdgeRowPtrs& e, float stiffness, int l) {
+  if constexpr (kOp == EdgeOp::kLocal)  // method 3's goal: P_{i-1} + the rotated rest edge
+    local_lane(ax, ay, az, bx, by, bz, aw + bw != 0.0f, e.ka[l], e.kb[l], ax + e.ex[l], ay + e.ey[l], az + e.ez[l],
+               stiffness);
+  else if constexpr (kOp == EdgeOp::kLength)
+    length_lane(ax, ay, az, bx, by, bz, aw, bw, e.rl[l]);
+}
+
+// Inlined, as edge_batch: a batch of a model-1 strand is about five edges, and a call per
+// batch cost more than the merging saved.
+template <EdgeOp kFirst, EdgeOp kSecond>
+[[gnu::always_inline]] inline void edge_pass(const Rows& r, const LocalRows& m, int first, int n) {
+  const float stiffness = m.stiffness;
+  const bool local = kFirst == EdgeOp::kLocal || kSecond == EdgeOp::kLocal;
+  for (int i = first; i < n; i += 2) {
+    const int a = (i - 1) * W, b = i * W;
+    const EdgeRowPtrs e{r.px + a,
+                        r.py + a,
+                        r.pz + a,
+                        r.px + b,
+                        r.py + b,
+                        r.pz + b,
+                        r.iw + a,
+                        r.iw + b,
+                        r.rl + b,
+                        local ? m.ka + b : nullptr,
+                        local ? m.kb + b : nullptr,
+                        local ? m.ex + b : nullptr,
+                        local ? m.ey + b : nullptr,
+                        local ? m.ez + b : nullptr};
+    LANES {
+      float ax = e.ax[l], ay = e.ay[l], az = e.az[l], bx = e.bx[l], by = e.by[l], bz = e.bz[l];
+      const float aw = e.aw[l], bw = e.bw[l];
+      apply_edge<kFirst>(ax, ay, az, bx, by, bz, aw, bw, e, stiffness, l);
+      apply_edge<kSecond>(ax, ay, az, bx, by, bz, aw, bw, e, stiffness, l);
+      e.ax[l] = ax;
+      e.ay[l] = ay;
+      e.az[l] = az;
+      e.bx[l] = bx;
+      e.by[l] = by;
+      e.bz[l] = bz;
     }
+  }
+}
+
+// One batch of parity `odd` (edges i = 1, 3, ... or 2, 4, ...) applying `first` then
+// `second` (kNone: one constraint only). Edge (0, 1) has no local constraint.
+[[gnu::always_inline]] inline void edge_batch(const Rows& r, const LocalRows& m, int n, bool odd, EdgeOp first,
+                                              EdgeOp second) {
+  if (odd && (first == EdgeOp::kLength || second == EdgeOp::kLength))
+    edge_pass<EdgeOp::kLength, EdgeOp::kNone>(r, m, 1, n < 2 ? n : 2);
+  const int i = odd ? 3 : 2;
+  if (first == EdgeOp::kLocal && second == EdgeOp::kLength)
+    edge_pass<EdgeOp::kLocal, EdgeOp::kLength>(r, m, i, n);
+  else if (first == EdgeOp::kLength && second == EdgeOp::kLocal)
+    edge_pass<EdgeOp::kLength, EdgeOp::kLocal>(r, m, i, n);
+  else if (first == EdgeOp::kLocal)
+    edge_pass<EdgeOp::kLocal, EdgeOp::kNone>(r, m, i, n);
+  else
+    edge_pass<EdgeOp::kLength, EdgeOp::kNone>(r, m, i, n);
+}
+
+// Algorithm 1 lines 7-9 for method 3: local shape and edge length iterations alternate,
+// each up to its count, as batches batch(odd, first, second) in order. With merge, a batch
+// of the parity of the one before joins it (see edge_pass).
+template <class Batch>
+void m3_iterations(int local_iterations, int length_iterations, bool merge, Batch&& batch) {
+  bool open = false, odd = false;
+  EdgeOp first = EdgeOp::kNone, second = EdgeOp::kNone;
+  auto add = [&](bool parity, EdgeOp op) {
+    if (open && merge && parity == odd && second == EdgeOp::kNone) {
+      second = op;
+      return;
+    }
+    if (open) batch(odd, first, second);
+    open = true;
+    odd = parity;
+    first = op;
+    second = EdgeOp::kNone;
+  };
+  const int iterations = local_iterations > length_iterations ? local_iterations : length_iterations;
+  for (int it = 0; it < iterations; ++it) {
+    if (it < local_iterations) {
+      add(false, EdgeOp::kLocal);
+      add(true, EdgeOp::kLocal);
+    }
+    if (it < length_iterations) {
+      add(true, EdgeOp::kLength);
+      add(false, EdgeOp::kLength);
+    }
+  }
+  if (open) batch(odd, first, second);
 }
 
 // Method 1 (Algorithm 3): serial root to tip, the frame rebuilt after every edge. Each
@@ -442,26 +591,9 @@ void local_m2(const Rows& r, int n, const float* lx, const float* ly, const floa
 
 // Edge length constraints (edge_length) in even/odd batches.
 void edge_length(const Rows& r, int n) {
-  for (int first : {1, 2})
-    for (int i = first; i < n; i += 2) {
-      const int a = (i - 1) * W, b = i * W;
-      float *ax = r.px + a, *ay = r.py + a, *az = r.pz + a, *bx = r.px + b, *by = r.py + b, *bz = r.pz + b;
-      const float *aw = r.iw + a, *bw = r.iw + b, *rl = r.rl + b;
-      LANES {
-        const float wsum = aw[l] + bw[l];
-        const float dx = bx[l] - ax[l], dy = by[l] - ay[l], dz = bz[l] - az[l];
-        const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
-        const bool on = wsum != 0.0f && len > 0.0f;
-        const float k = (len - rl[l]) / (len * wsum);
-        const float cx = dx * k, cy = dy * k, cz = dz * k;
-        ax[l] = on ? ax[l] + aw[l] * cx : ax[l];
-        ay[l] = on ? ay[l] + aw[l] * cy : ay[l];
-        az[l] = on ? az[l] + aw[l] * cz : az[l];
-        bx[l] = on ? bx[l] - bw[l] * cx : bx[l];
-        by[l] = on ? by[l] - bw[l] * cy : by[l];
-        bz[l] = on ? bz[l] - bw[l] * cz : bz[l];
-      }
-    }
+  const LocalRows none{};
+  edge_batch(r, none, n, true, EdgeOp::kLength, EdgeOp::kNone);
+  edge_batch(r, none, n, false, EdgeOp::kLength, EdgeOp::kNone);
 }
 
 // The lanes of a row (x, y, z, inverse mass) inside sphere (cx, cy, cz, r), as a bit
@@ -570,10 +702,19 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
   }
   const bool local_on = p.local_iterations > 0;
   const int iterations = p.local_iterations > p.length_iterations ? p.local_iterations : p.length_iterations;
+  // Stages that share their passes over the rows (global shape inside integration;
+  // method 3's local and length batches merged, edge_pass) do so except in the sampled
+  // blocks that time their stages: those run every stage apart, so that each has its own
+  // clock reads. The same bits either way.
+  const bool fuse = stage_ns == nullptr;
+  const bool global_apart = p.global_on && !fuse;
+  int m3_batches = 0;
+  if (method == 3)
+    m3_iterations(p.local_iterations, p.length_iterations, fuse, [&](bool, EdgeOp, EdgeOp) { ++m3_batches; });
   soa::StageClock clock(stage_ns);
   // Each finished stage requests its share of the next job's lines.
-  const int per_substep = 1 + p.global_on + (local_on && method == 3) + p.local_iterations + p.length_iterations +
-                          (f.substep_count > 0 && f.substeps[0].sphere_count > 0);
+  const int solve = method == 3 ? local_on + m3_batches : p.local_iterations + p.length_iterations;
+  const int per_substep = 1 + global_apart + solve + (f.substep_count > 0 && f.substeps[0].sphere_count > 0);
   feed.pace(local_on + f.substep_count * per_substep);
   auto done = [&](Stage stage) {
     clock.lap(stage);
@@ -585,23 +726,39 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
   }
   for (int k = 0; k < f.substep_count; ++k) {
     const Substep& s = f.substeps[k];
-    for (int j = 0; j < count; ++j) {
-      if (f.windy)
-        integrate<true>(c[j].r, c[j].kinds, n, s, f, p.keep);
-      else
-        integrate<false>(c[j].r, c[j].kinds, n, s, f, p.keep);
-    }
+    auto integrate_blocks = [&]<bool kWindy, bool kGlobal>() {
+      for (int j = 0; j < count; ++j) integrate<kWindy, kGlobal>(c[j].r, c[j].kinds, n, s, f, p);
+    };
+    const bool global_in = p.global_on && fuse;
+    if (f.windy)
+      global_in ? integrate_blocks.template operator()<true, true>()
+                : integrate_blocks.template operator()<true, false>();
+    else
+      global_in ? integrate_blocks.template operator()<false, true>()
+                : integrate_blocks.template operator()<false, false>();
     done(kIntegrate);
-    if (p.global_on) {
+    if (global_apart) {
       for (int j = 0; j < count; ++j) global_shape(c[j].r, c[j].kinds, n, s, p);
       done(kGlobal);
     }
-    if (local_on && method == 3) {
-      for (int j = 0; j < count; ++j) rest_edges_m3(c[j].r, n, s, c[j].scratch, c[j].scratch + rows, c[j].scratch + 2 * rows);
-      done(kLocal);
+    if (method == 3) {
+      if (local_on) {
+        for (int j = 0; j < count; ++j)
+          rest_edges_m3(c[j].r, n, s, c[j].scratch, c[j].scratch + rows, c[j].scratch + 2 * rows);
+        done(kLocal);
+      }
+      m3_iterations(p.local_iterations, p.length_iterations, fuse, [&](bool odd, EdgeOp first, EdgeOp second) {
+        for (int j = 0; j < count; ++j) {
+          const Ctx& b = c[j];
+          const LocalRows m{b.scratch, b.scratch + rows, b.scratch + 2 * rows, b.ka, b.kb, p.local_stiffness};
+          edge_batch(b.r, m, n, odd, first, second);
+        }
+        done(first == EdgeOp::kLocal ? kLocal : kLength);
+      });
     }
-    // Algorithm 1 lines 7-9: local shape and edge length alternate, each up to its count.
-    for (int it = 0; it < iterations; ++it) {
+    // Algorithm 1 lines 7-9 for methods 1 and 2: local shape and edge length alternate,
+    // each up to its count.
+    for (int it = 0; method != 3 && it < iterations; ++it) {
       if (it < p.local_iterations) {
         if (method == 1) {
           if (count == 2)
@@ -611,11 +768,8 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
         } else {
           for (int j = 0; j < count; ++j) {
             const Ctx& b = c[j];
-            if (method == 2)
-              local_m2(b.r, n, b.field(LX), b.field(LY), b.field(LZ), b.rest_frames, b.field(OW), b.field(OX),
-                       b.field(OY), b.field(OZ), b.scratch, b.ka, b.kb, s, p.local_stiffness);
-            else
-              local_m3(b.r, n, b.scratch, b.scratch + rows, b.scratch + 2 * rows, b.ka, b.kb, p.local_stiffness);
+            local_m2(b.r, n, b.field(LX), b.field(LY), b.field(LZ), b.rest_frames, b.field(OW), b.field(OX),
+                     b.field(OY), b.field(OZ), b.scratch, b.ka, b.kb, s, p.local_stiffness);
           }
         }
         done(kLocal);
