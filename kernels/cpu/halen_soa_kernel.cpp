@@ -246,7 +246,9 @@ inline bool any_lane(const int* flags) {
 // sphere is not moved by any pass, so only those rows take the per-strand kernel's
 // passes, all lanes at once with the lanes outside masked off. A lane whose pass moved
 // nothing would move no more in later passes (the same position meets the same tests), so
-// the row stops when no lane moved, as each strand's loop does. Vector pushes beat one
+// the row stops when no lane moved, as each strand's loop does; and, for the same reason,
+// when a pass left the row as it was, bit for bit (lanes projected onto a sphere that
+// round to points still inside it repeat the same projection; han_soa_kernel.cpp). Vector pushes beat one
 // scalar push per lane inside: the cascade's strands rest on the spheres with several
 // lanes of a row inside (measured 8% of its frame on model 1, the spring model even).
 // The test accumulates into every lane with bitwise operations (no branch, no reduction
@@ -274,6 +276,10 @@ void collide(const Rows& r, const Substep& s) {
     if (!any_lane(hit)) continue;
     for (int pass = 0; pass < kPasses; ++pass) {
       alignas(64) int moved[W];
+      alignas(64) float ox[W], oy[W], oz[W];  // the row before this pass
+      std::memcpy(ox, px, sizeof ox);
+      std::memcpy(oy, py, sizeof oy);
+      std::memcpy(oz, pz, sizeof oz);
       LANES { moved[l] = 0; }
       for (int c = 0; c < s.sphere_count; ++c) {
         const float sx = s.spheres[4 * c], sy = s.spheres[4 * c + 1], sz = s.spheres[4 * c + 2],
@@ -293,7 +299,8 @@ void collide(const Rows& r, const Substep& s) {
           moved[l] |= static_cast<int>(inside);
         }
       }
-      if (!any_lane(moved)) break;
+      const bool same = soa::same_bits(ox, px) && soa::same_bits(oy, py) && soa::same_bits(oz, pz);
+      if (!any_lane(moved) || same) break;
     }
   }
 }

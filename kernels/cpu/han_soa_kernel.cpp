@@ -257,7 +257,8 @@ inline void integrate_row(const Rows& r, int i, const soa::AffinePose& h, const 
 
 // Eq. 2 (global_shape) on row i: free vertices below reach move towards T_H · P_i^0. The
 // pose is taken by value, as in follow_head_row.
-inline void global_row(const Rows& r, RowKind kind, int i, const soa::AffinePose h, const BlockParams& p) {
+[[gnu::always_inline]] inline void global_row(const Rows& r, RowKind kind, int i, const soa::AffinePose h,
+                                              const BlockParams& p) {
   if (kind == kRowPinned || !(static_cast<float>(i) < p.global_reach)) return;
   const int o = i * W;
   float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
@@ -619,8 +620,12 @@ inline unsigned inside_mask(const float* px, const float* py, const float* pz, c
 #endif
 }
 
-// Sphere collisions (collide_spheres): up to four passes; a lane whose pass moved
-// nothing would move nothing in later passes either, so passes stop when no lane moved.
+// Sphere collisions (collide_spheres): up to four passes. A pass depends on the row alone,
+// so passes stop once one leaves the row as it was, bit for bit: every pass after it
+// would do the same. That is the case when no lane was inside, and also often when the
+// lanes projected onto a sphere round to points still inside it: the projection then
+// repeats itself (model 1 groom: 569,500 of the 1,025,003 passes of 296,321 rows in
+// contact over 120 frames; stopping at the first saves 35% of the passes, issue 10).
 // Most rows have no lane inside any sphere: they are found by one test of every sphere
 // (a row outside every sphere is not moved by any pass).
 void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
@@ -636,6 +641,10 @@ void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
       any |= inside_mask(px, py, pz, iw, sp[4 * c], sp[4 * c + 1], sp[4 * c + 2], sp[4 * c + 3]);
     if (!any) continue;
     for (int pass = 0; pass < kPasses; ++pass) {
+      alignas(64) float ox[W], oy[W], oz[W];  // the row before this pass
+      std::memcpy(ox, px, sizeof ox);
+      std::memcpy(oy, py, sizeof oy);
+      std::memcpy(oz, pz, sizeof oz);
       bool moved = false;
       for (int c = 0; c < s.sphere_count; ++c) {
         const float cx = sp[4 * c], cy = sp[4 * c + 1], cz = sp[4 * c + 2], cr = sp[4 * c + 3];
@@ -653,7 +662,7 @@ void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
           pz[l] = inside ? cz + nz * cr : pz[l];
         }
       }
-      if (!moved) break;
+      if (!moved || (soa::same_bits(ox, px) && soa::same_bits(oy, py) && soa::same_bits(oz, pz))) break;
     }
   }
 }

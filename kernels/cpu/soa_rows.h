@@ -6,7 +6,9 @@
 
 #include "kernels/cpu/soa_common.h"
 
+#include <bit>
 #include <cstddef>
+#include <cstdint>
 
 #if defined(__AVX512F__)
 #include <immintrin.h>
@@ -33,6 +35,15 @@ inline void follow_head_row(const AffinePose h, float* __restrict px, float* __r
     qy[l] = y;
     qz[l] = z;
   }
+}
+
+// Whether two rows hold the same bits in every lane (a sphere collision pass that leaves
+// a row so would leave it so again: the collide functions stop there).
+inline bool same_bits(const float* a, const float* b) {
+  std::uint32_t diff = 0;
+  _Pragma("GCC ivdep") for (int l = 0; l < kRowLanes; ++l) diff |=
+      std::bit_cast<std::uint32_t>(a[l]) ^ std::bit_cast<std::uint32_t>(b[l]);
+  return diff == 0;
 }
 
 // Rows 0..n-1 of x, y, z and w (16 lanes each, consecutive rows 16 floats apart) to
