@@ -129,6 +129,17 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
 }
 #pragma GCC diagnostic pop
 
+// Where `on`, an edge constraint's new end positions replace a and b (one lane's values).
+inline void move_edge_if(bool on, float& ax, float& ay, float& az, float& bx, float& by, float& bz, float nax,
+                         float nay, float naz, float nbx, float nby, float nbz) {
+  ax = on ? nax : ax;
+  ay = on ? nay : ay;
+  az = on ? naz : az;
+  bx = on ? nbx : bx;
+  by = on ? nby : by;
+  bz = on ? nbz : bz;
+}
+
 // Eq. 4 (local_shape_edge) on one lane's values: a and b move towards goal g by their
 // mass weights ka, kb (mass_weights), where `on` (not both pinned).
 inline void local_lane(float& ax, float& ay, float& az, float& bx, float& by, float& bz, bool on, float ka, float kb,
@@ -136,12 +147,7 @@ inline void local_lane(float& ax, float& ay, float& az, float& bx, float& by, fl
   const float dx = stiffness * (gx - bx), dy = stiffness * (gy - by), dz = stiffness * (gz - bz);
   const float nax = ax - dx * ka, nay = ay - dy * ka, naz = az - dz * ka;
   const float nbx = bx + dx * kb, nby = by + dy * kb, nbz = bz + dz * kb;
-  ax = on ? nax : ax;
-  ay = on ? nay : ay;
-  az = on ? naz : az;
-  bx = on ? nbx : bx;
-  by = on ? nby : by;
-  bz = on ? nbz : bz;
+  move_edge_if(on, ax, ay, az, bx, by, bz, nax, nay, naz, nbx, nby, nbz);
 }
 
 // The local shape constraint of edge (a, b) towards goal (Eq. 4, local_shape_edge).
@@ -361,12 +367,7 @@ inline void length_lane(float& ax, float& ay, float& az, float& bx, float& by, f
   const float cx = dx * k, cy = dy * k, cz = dz * k;
   const float nax = ax + aw * cx, nay = ay + aw * cy, naz = az + aw * cz;
   const float nbx = bx - bw * cx, nby = by - bw * cy, nbz = bz - bw * cz;
-  ax = on ? nax : ax;
-  ay = on ? nay : ay;
-  az = on ? naz : az;
-  bx = on ? nbx : bx;
-  by = on ? nby : by;
-  bz = on ? nbz : bz;
+  move_edge_if(on, ax, ay, az, bx, by, bz, nax, nay, naz, nbx, nby, nbz);
 }
 
 // A pass over the edges (i-1, i), i = first, first + 2, ... < n: the local constraint of
