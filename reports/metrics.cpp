@@ -36,12 +36,51 @@ METRIC_INLINE double distance2(const Vec4f& a, const Vec4f& b) {
                dz = double(a.z()) - double(b.z());
   return (dx * dx + dy * dy) + dz * dz;
 }
+// The lanes of the vector code below (LaneVec): strands side by side in jaggedness,
+// vertices in penetration.
+constexpr int kLanes = 8;
+
+// The strands of each size >= 4 in groups of kLanes (in index order), and those left over.
+void group_for_lanes(const Groom& g, std::vector<std::uint32_t>& grouped, std::vector<std::uint32_t>& alone) {
+  std::vector<std::uint32_t> order(g.strand_count());
+  for (std::uint32_t s = 0; s < order.size(); ++s) order[s] = s;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return g.strand_size(a) < g.strand_size(b); });
+  for (std::size_t i = 0; i < order.size();) {
+    const std::size_t n = g.strand_size(order[i]);
+    std::size_t j = i;
+    while (j < order.size() && g.strand_size(order[j]) == n) ++j;
+    const std::size_t lanes = n >= 4 ? (j - i) / kLanes * kLanes : 0;
+    grouped.insert(grouped.end(), order.begin() + i, order.begin() + i + lanes);
+    alone.insert(alone.end(), order.begin() + i + lanes, order.begin() + j);
+    i = j;
+  }
+  std::sort(alone.begin(), alone.end());
+}
+
 template <class Term, class Add>
 METRIC_INLINE void chunked(std::size_t begin, std::size_t end, Term term, Add add) {
-  double buf[kChunk];
+  decltype(term(begin)) buf[kChunk];
   for (std::size_t c = begin; c < end; c += kChunk) {
     const std::size_t m = std::min(kChunk, end - c);
     for (std::size_t k = 0; k < m; ++k) buf[k] = term(c + k);
+    for (std::size_t k = 0; k < m; ++k) add(buf[k]);
+  }
+}
+
+// chunked over the edges (i - 1, i) of every strand, i in [1, end), as one run over the
+// groom's vertices instead of one per strand (model 1's strands have about 11 vertices,
+// too few for a loop per strand to vectorise): term(i) for every i, then 0 at the
+// strands' roots, where no edge ends (their terms, computed with a rest length of 0, are
+// not used). add must leave its state as it was when given 0.
+template <class Term, class Add>
+METRIC_INLINE void edge_chunked(const Groom& g, std::size_t end, Term term, Add add) {
+  decltype(term(1)) buf[kChunk];
+  std::size_t s = 1;  // the next strand whose root is not yet behind (strand 0's is vertex 0)
+  for (std::size_t c = 1; c < end; c += kChunk) {
+    const std::size_t m = std::min(kChunk, end - c);
+    for (std::size_t k = 0; k < m; ++k) buf[k] = term(c + k);
+    for (; s < g.strand_count() && g.strand_begin(s) < c + m; ++s) buf[g.strand_begin(s) - c] = 0;
     for (std::size_t k = 0; k < m; ++k) add(buf[k]);
   }
 }
@@ -59,6 +98,7 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
         std::span(rest.positions).subspan(rest.strand_begin(s), rest.strand_size(s)));
     head_extent = std::max(head_extent, xyz(rest.positions[rest.strand_begin(s)]).norm());
   }
+  group_for_lanes(rest, jagged_grouped, jagged_alone);
 }
 
 METRIC_CLONES double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length) {
@@ -104,148 +144,205 @@ namespace {
 
 // strand_jaggedness_raw of kLanes strands of n >= 4 vertices each at once, one strand per
 // lane: every lane repeats that function's operations in Eigen's order for 3-vectors
-// (sums left to right, cross product by components), so each strand gets the same bits,
-// and the loops over lanes vectorise, the divisions and square roots with them
-// (issue 10: the metrics cost about as much as a fast model's step in `compare`).
-constexpr int kLanes = 8;
-#define METRIC_LANES _Pragma("GCC ivdep") for (int l = 0; l < kLanes; ++l)
+// (sums left to right, cross product by components), so each strand gets the same bits.
+// The lanes are one GCC vector (LaneVec), whose operations are those IEEE operations lane
+// by lane: written as loops over arrays, GCC kept the running sums and the previous
+// binormal in scalar registers and added them one lane at a time (issue 10: the metrics
+// cost about as much as a fast model's step in `compare`).
+using LaneVec = double __attribute__((vector_size(kLanes * sizeof(double))));
 
-struct Edges {
-  double x[kLanes], y[kLanes], z[kLanes], len[kLanes];
+// Lane by lane square root (a vector square root instruction where the target has one).
+METRIC_INLINE void lane_sqrt(const LaneVec& v, LaneVec& out) {
+  for (int l = 0; l < kLanes; ++l) out[l] = std::sqrt(v[l]);
+}
+
+// std::max(a, b) lane by lane: b where a < b, else a.
+METRIC_INLINE void lane_max(const LaneVec& a, const LaneVec& b, LaneVec& out) { out = a < b ? b : a; }
+
+struct LanePoints {
+  LaneVec x, y, z;
 };
 
-// Edge i -> i + 1 of each lane's strand, and its length.
-METRIC_INLINE void lane_edges(std::span<const Vec4f> p, const std::size_t* begin, std::size_t i, Edges& e) {
-  METRIC_LANES {
+// Vertex i of each lane's strand, in double.
+METRIC_INLINE void lane_points(std::span<const Vec4f> p, const std::size_t* begin, std::size_t i, LanePoints& v) {
+  for (int l = 0; l < kLanes; ++l) {
     const Vec4f& a = p[begin[l] + i];
-    const Vec4f& b = p[begin[l] + i + 1];
-    e.x[l] = double(b.x()) - double(a.x());
-    e.y[l] = double(b.y()) - double(a.y());
-    e.z[l] = double(b.z()) - double(a.z());
-    e.len[l] = std::sqrt((e.x[l] * e.x[l] + e.y[l] * e.y[l]) + e.z[l] * e.z[l]);
+    v.x[l] = double(a.x());
+    v.y[l] = double(a.y());
+    v.z[l] = double(a.z());
   }
+}
+
+struct LaneEdges {
+  LaneVec x, y, z, len;
+};
+
+// Edge a -> b of each lane, and its length.
+METRIC_INLINE void lane_edges(const LanePoints& a, const LanePoints& b, LaneEdges& e) {
+  e.x = b.x - a.x;
+  e.y = b.y - a.y;
+  e.z = b.z - a.z;
+  lane_sqrt((e.x * e.x + e.y * e.y) + e.z * e.z, e.len);
 }
 
 // curvature_binormal per lane.
-METRIC_INLINE void lane_binormals(const Edges& e0, const Edges& e1, double (&kb)[3][kLanes]) {
-  METRIC_LANES {
-    const double lens = e0.len[l] * e1.len[l];
-    const double dot = (e0.x[l] * e1.x[l] + e0.y[l] * e1.y[l]) + e0.z[l] * e1.z[l];
-    const double denom = std::max(lens + dot, 1e-12 * std::max(lens, 1e-30));
-    kb[0][l] = 2.0 * (e0.y[l] * e1.z[l] - e0.z[l] * e1.y[l]) / denom;
-    kb[1][l] = 2.0 * (e0.z[l] * e1.x[l] - e0.x[l] * e1.z[l]) / denom;
-    kb[2][l] = 2.0 * (e0.x[l] * e1.y[l] - e0.y[l] * e1.x[l]) / denom;
-  }
+METRIC_INLINE void lane_binormals(const LaneEdges& e0, const LaneEdges& e1, LaneVec (&kb)[3]) {
+  const LaneVec lens = e0.len * e1.len;
+  const LaneVec dot = (e0.x * e1.x + e0.y * e1.y) + e0.z * e1.z;
+  LaneVec floored, denom;
+  lane_max(lens, LaneVec{} + 1e-30, floored);
+  lane_max(lens + dot, 1e-12 * floored, denom);
+  kb[0] = 2.0 * (e0.y * e1.z - e0.z * e1.y) / denom;
+  kb[1] = 2.0 * (e0.z * e1.x - e0.x * e1.z) / denom;
+  kb[2] = 2.0 * (e0.x * e1.y - e0.y * e1.x) / denom;
 }
 
 METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const std::size_t* begin, std::size_t n, double* out) {
-  Edges e0, e1;
-  double prev[3][kLanes], kb[3][kLanes], sum[kLanes];
-  lane_edges(p, begin, 0, e0);
-  lane_edges(p, begin, 1, e1);
+  LanePoints a, b;  // vertices i and i + 1
+  LaneEdges e0, e1;
+  LaneVec prev[3], kb[3], sum{};
+  lane_points(p, begin, 0, a);
+  lane_points(p, begin, 1, b);
+  lane_edges(a, b, e0);
+  lane_points(p, begin, 2, a);
+  lane_edges(b, a, e1);
   lane_binormals(e0, e1, prev);
-  METRIC_LANES sum[l] = 0.0;
   for (std::size_t i = 2; i + 1 < n; ++i) {
+    b = a;
+    lane_points(p, begin, i + 1, a);
     e0 = e1;
-    lane_edges(p, begin, i, e1);
+    lane_edges(b, a, e1);
     lane_binormals(e0, e1, kb);
-    METRIC_LANES {
-      const double dx = kb[0][l] - prev[0][l], dy = kb[1][l] - prev[1][l], dz = kb[2][l] - prev[2][l];
-      sum[l] += (dx * dx + dy * dy) + dz * dz;
-      prev[0][l] = kb[0][l];
-      prev[1][l] = kb[1][l];
-      prev[2][l] = kb[2][l];
-    }
+    const LaneVec dx = kb[0] - prev[0], dy = kb[1] - prev[1], dz = kb[2] - prev[2];
+    sum += (dx * dx + dy * dy) + dz * dz;
+    prev[0] = kb[0];
+    prev[1] = kb[1];
+    prev[2] = kb[2];
   }
-  METRIC_LANES out[l] = std::sqrt(sum[l] / static_cast<double>(n - 3));
+  LaneVec root;
+  lane_sqrt(sum / static_cast<double>(n - 3), root);
+  for (int l = 0; l < kLanes; ++l) out[l] = root[l];
 }
 
 }  // namespace
 
+// Strands are grouped by size at load (group_for_lanes): a ragged groom such as Table 1's
+// model 1 rarely has kLanes consecutive strands of one size, and the strands left alone
+// took a fifth of `compare --models han_m3` on it (issue 10). Each strand's value is the
+// same either way, and they are added in index order: the same bits.
 METRIC_CLONES double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;
   const std::size_t strands = g.strand_count();
-  double sum = 0.0;
-  std::size_t begin[kLanes];
-  double raw[kLanes];
-  for (std::size_t s = 0; s < strands;) {
-    // kLanes strands of one size >= 4 together; the strands are added in order either way.
-    const std::size_t n = g.strand_size(s);
-    bool together = n >= 4 && s + kLanes <= strands;
-    for (int l = 0; l < kLanes && together; ++l) {
-      together = g.strand_size(s + l) == n;
-      begin[l] = g.strand_begin(s + l);
-    }
-    if (together) {
-      lane_jaggedness(p, begin, n, raw);
-      for (int l = 0; l < kLanes; ++l) sum += raw[l] - rest.rest_jaggedness[s + l];
-      s += kLanes;
-    } else {
-      sum += strand_jaggedness_raw(p.subspan(g.strand_begin(s), n)) - rest.rest_jaggedness[s];
-      ++s;
-    }
+  thread_local std::vector<double> raw;  // per strand; the metrics of lanes run on several threads
+  raw.resize(strands);
+  const std::vector<std::uint32_t>& grouped = rest.jagged_grouped;
+  for (std::size_t k = 0; k < grouped.size(); k += kLanes) {
+    std::size_t begin[kLanes];
+    double out[kLanes];
+    for (int l = 0; l < kLanes; ++l) begin[l] = g.strand_begin(grouped[k + l]);
+    lane_jaggedness(p, begin, g.strand_size(grouped[k]), out);
+    for (int l = 0; l < kLanes; ++l) raw[grouped[k + l]] = out[l];
   }
+  for (const std::uint32_t s : rest.jagged_alone)
+    raw[s] = strand_jaggedness_raw(p.subspan(g.strand_begin(s), g.strand_size(s)));
+  double sum = 0.0;
+  for (std::size_t s = 0; s < strands; ++s) sum += raw[s] - rest.rest_jaggedness[s];
   return sum / static_cast<double>(strands);
 }
 
+// The edges are added in the order of the strands and, within a strand, from the root:
+// the terms of one run over the groom (edge_chunked), in which a root adds 0 to the sum
+// of squares (x + 0 is x, for any x this sum can hold) and to the maximum (never above 0
+// at a root, never NaN). The same bits.
 METRIC_CLONES LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;
+  const float* rl = rest.rest_length.data();
   LengthError out;
   double sum = 0.0;
+  edge_chunked(
+      g, p.size(),
+      [&](std::size_t i) { return std::abs(std::sqrt(distance2(p[i], p[i - 1])) - double(rl[i])) / double(rl[i]); },
+      [&](double e) {
+        sum += e * e;
+        out.max = std::max(out.max, e);
+      });
   std::size_t edges = 0;
-  for (std::size_t s = 0; s < g.strand_count(); ++s) {
-    const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
-    chunked(
-        b + 1, b + n,
-        [&](std::size_t i) {
-          return std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
-        },
-        [&](double e) {
-          sum += e * e;
-          out.max = std::max(out.max, e);
-          ++edges;
-        });
-  }
+  for (std::size_t s = 0; s < g.strand_count(); ++s) edges += std::max<std::size_t>(g.strand_size(s), 1) - 1;
   out.rms = edges ? std::sqrt(sum / static_cast<double>(edges)) : 0.0;
   return out;
 }
 
+// T_H p^0 is Eigen's Affine3f product, written out in its order (as soa::AffinePose) so
+// that the loop vectorises. Eigen sums the squared difference of a Vector3d and a cast
+// Vector3f as x^2 + (y^2 + z^2), unlike distance2's two Vector3d.
 METRIC_CLONES double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Affine3f& head) {
-  const Affine3f& h = head;
+  const Eigen::Matrix3f m = head.linear();
+  const Vec3f t = head.translation();
   double sum = 0.0;
-  const auto& r = rest.groom->positions;
+  const Vec4f* r = rest.groom->positions.data();
   chunked(
       0, p.size(),
       [&](std::size_t i) {
-        const Vec3f goal = h * Vec3f(r[i].head<3>());
-        return (xyz(p[i]) - goal.cast<double>()).squaredNorm();
+        const float a = r[i].x(), b = r[i].y(), c = r[i].z();
+        const float gx = t.x() + ((m(0, 0) * a + m(0, 1) * b) + m(0, 2) * c);
+        const float gy = t.y() + ((m(1, 0) * a + m(1, 1) * b) + m(1, 2) * c);
+        const float gz = t.z() + ((m(2, 0) * a + m(2, 1) * b) + m(2, 2) * c);
+        const double dx = double(p[i].x()) - double(gx), dy = double(p[i].y()) - double(gy),
+                     dz = double(p[i].z()) - double(gz);
+        return dx * dx + (dy * dy + dz * dz);
       },
       [&](double t) { sum += t; });
   return std::sqrt(sum / static_cast<double>(p.size())) / rest.mean_strand_length;
 }
 
+// The smallest squared distance (distance2) from the vertices to each of M spheres, in
+// kLanes running minima per sphere: each vertex is loaded and widened once for all M.
+template <int M>
+METRIC_INLINE void nearest2(std::span<const Vec4f> p, const Vec4f* spheres, double* out) {
+  const std::size_t whole = p.size() / kLanes * kLanes;
+  LaneVec lane_min[M];
+  for (int k = 0; k < M; ++k) lane_min[k] = LaneVec{} + std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < whole; i += kLanes) {
+    const std::size_t begin[kLanes] = {i, i + 1, i + 2, i + 3, i + 4, i + 5, i + 6, i + 7};
+    LanePoints v;
+    lane_points(p, begin, 0, v);
+    for (int k = 0; k < M; ++k) {
+      const LaneVec dx = v.x - double(spheres[k].x()), dy = v.y - double(spheres[k].y()),
+                    dz = v.z - double(spheres[k].z());
+      const LaneVec d = (dx * dx + dy * dy) + dz * dz;
+      lane_min[k] = d < lane_min[k] ? d : lane_min[k];
+    }
+  }
+  for (int k = 0; k < M; ++k) {
+    double m = std::numeric_limits<double>::infinity();
+    for (std::size_t i = whole; i < p.size(); ++i) {
+      const double d = distance2(p[i], spheres[k]);
+      m = d < m ? d : m;
+    }
+    for (int l = 0; l < kLanes; ++l) m = lane_min[k][l] < m ? lane_min[k][l] : m;
+    out[k] = m;
+  }
+}
+
 // Per sphere, the depth r - |v - c| is largest at the smallest squared distance: the
 // rounded square root and subtraction are monotonic, so the depth of the nearest vertex
 // is the bits of the largest depth (NaN distances are skipped, as std::max skipped
-// them). A depth below 0 adds nothing. The minimum is taken in kLanes running minima,
-// combined at the end: a minimum of squares (never -0) does not depend on the order.
+// them). A depth below 0 adds nothing. A minimum of squares (never -0) does not depend on
+// the order in which it is taken. Up to four spheres share a pass over the vertices.
 METRIC_CLONES double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres) {
   double deepest = 0.0;
-  for (const Vec4f& s : world_spheres) {
-    double lane_min[kLanes];
-    METRIC_LANES lane_min[l] = std::numeric_limits<double>::infinity();
-    const std::size_t whole = p.size() / kLanes * kLanes;
-    for (std::size_t i = 0; i < whole; i += kLanes) METRIC_LANES {
-        const double d = distance2(p[i + l], s);
-        lane_min[l] = d < lane_min[l] ? d : lane_min[l];
-      }
-    double nearest2 = std::numeric_limits<double>::infinity();
-    for (std::size_t i = whole; i < p.size(); ++i) {
-      const double d = distance2(p[i], s);
-      nearest2 = d < nearest2 ? d : nearest2;
+  if (p.empty()) return deepest;
+  for (std::size_t c = 0; c < world_spheres.size(); c += 4) {
+    const Vec4f* s = world_spheres.data() + c;
+    double d2[4];
+    switch (std::min<std::size_t>(4, world_spheres.size() - c)) {
+      case 1: nearest2<1>(p, s, d2); break;
+      case 2: nearest2<2>(p, s, d2); break;
+      case 3: nearest2<3>(p, s, d2); break;
+      default: nearest2<4>(p, s, d2); break;
     }
-    for (int l = 0; l < kLanes; ++l) nearest2 = lane_min[l] < nearest2 ? lane_min[l] : nearest2;
-    if (p.size() > 0) deepest = std::max(deepest, double(s.w()) - std::sqrt(nearest2));
+    for (std::size_t k = 0; k < 4 && c + k < world_spheres.size(); ++k)
+      deepest = std::max(deepest, double(s[k].w()) - std::sqrt(d2[k]));
   }
   return deepest;
 }
@@ -265,21 +362,42 @@ METRIC_CLONES std::string blowup_reason(const RestInfo& rest, std::span<const Ve
   const Groom& g = *rest.groom;
   const double far = rest.head_extent + 10.0 * rest.mean_strand_length;
   const Eigen::Vector3d c = head_center.cast<double>();
-  // A screen per strand first, without branches so that it vectorises: squared lengths
-  // against bounds a little inside the tests' (0.98 far^2 against far^2; 0.26 r^2 and
-  // 2.2 r^2 against (0.5 r)^2 and (1.5 r)^2), where NaN and Inf fail every comparison.
-  // Only a strand the screen flags takes the exact tests, in order, so the first failure
-  // reported is the same; the square roots and branches per vertex were most of this
-  // function's cost, which `compare` pays per model and frame (issue 10).
+  // A screen first, without branches so that it vectorises: squared lengths against
+  // bounds a little inside the tests' (0.98 far^2 against far^2; 0.26 r^2 and 2.2 r^2
+  // against (0.5 r)^2 and (1.5 r)^2), where NaN and Inf fail every comparison. It runs
+  // over the whole groom at once (edge_chunked); only if it flags a vertex or edge do the
+  // strands take it one by one, and only a strand it flags takes the exact tests, in
+  // order, so the first failure reported is the same. The square roots and branches per
+  // vertex were most of this function's cost, which `compare` pays per model and frame
+  // (issue 10).
   constexpr double kNear = 0.98, kShort = 0.26, kLong = 2.2;
   const double near2 = kNear * far * far;
+  const Vec4f centre(head_center.x(), head_center.y(), head_center.z(), 0.0f);
+  const float* rl = rest.rest_length.data();
+  int any = 0;
+  chunked(
+      0, p.size(),
+      [&](std::size_t i) {
+        return int{!(distance2(p[i], centre) <= near2)} | int{!(p[i].w() * 0.0f == 0.0f)};  // w: NaN, Inf
+      },
+      [&](int flag) { any |= flag; });
+  const std::size_t simulated_end =
+      rest.simulated_strands < g.strand_count() ? g.strand_begin(rest.simulated_strands) : p.size();
+  edge_chunked(
+      g, simulated_end,
+      [&](std::size_t i) {
+        const double l2 = distance2(p[i], p[i - 1]), r2 = double(rl[i]) * double(rl[i]);
+        return int{!(l2 > kShort * r2)} | int{!(l2 < kLong * r2)};
+      },
+      [&](int flag) { any |= flag; });
+  if (!any) return {};
   for (std::size_t s = 0; s < g.strand_count(); ++s) {
     const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
     const bool simulated = s < rest.simulated_strands;
     int flagged = 0;
     for (std::size_t i = b; i < b + n; ++i)
       flagged |= static_cast<int>(!((xyz(p[i]) - c).squaredNorm() <= near2)) |
-                 static_cast<int>(!(p[i].w() * 0.0f == 0.0f));  // w: NaN or Inf
+                 static_cast<int>(!(p[i].w() * 0.0f == 0.0f));
     if (simulated)
       for (std::size_t i = b + 1; i < b + n; ++i) {
         const double l2 = (xyz(p[i]) - xyz(p[i - 1])).squaredNorm(), r2 = rest.rest_length[i] * rest.rest_length[i];

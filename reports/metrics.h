@@ -22,6 +22,9 @@ struct RestInfo {
   std::vector<float> rest_length;        // per edge, indexed by its second vertex
   double mean_strand_length;             // L-bar
   std::vector<double> rest_jaggedness;   // per strand, raw (not rest-subtracted)
+  // The strands jaggedness computes several at a time (one size >= 4, in groups of its
+  // lane count, metrics.cpp), and the others, one at a time; each in index order.
+  std::vector<std::uint32_t> jagged_grouped, jagged_alone;
   double head_extent;                    // largest root distance from the head centre (rest frame origin)
   std::size_t simulated_strands;
 };

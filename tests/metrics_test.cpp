@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 namespace hairbench {
 namespace {
@@ -37,17 +38,43 @@ TEST(Jaggedness, ZeroOnRestShape) {
   EXPECT_EQ(metrics::jaggedness(rest, g.positions), 0.0);
 }
 
-// Eight strands of one size go through the lane code together, the rest one at a time:
-// the groom value is the serial sum of strand_jaggedness_raw, bit for bit.
-TEST(Jaggedness, LanesGiveTheSerialBits) {
-  const Groom g = bent_groom(19, 12);
-  const metrics::RestInfo rest(g);
+// 30 strands of interleaved sizes, as in a ragged groom: 12 of 12 vertices, 9 of 13, 6 of
+// 5 and 3 of 3 (303 vertices: not a whole number of vector lanes).
+Groom ragged_groom() {
+  Groom g;
+  for (int s = 0; s < 30; ++s) {
+    const int n = s % 10 == 9 ? 3 : s % 5 == 1 ? 5 : s % 2 == 0 ? 12 : 13;
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < n; ++i) {
+      const float a = 0.5f * float(M_PI) * float(i) / float(n - 1);
+      pts.emplace_back(0.2f * std::sin(a) + 0.05f * float(s), 0.2f * std::cos(a), 0.01f * float(s));
+    }
+    g.add_strand(pts, 0);
+  }
+  return g;
+}
+
+// The groom's positions bent out of their planes, unevenly.
+std::vector<Vec4f> perturbed(const Groom& g) {
   std::vector<Vec4f> p = g.positions;
-  for (std::size_t k = 0; k < p.size(); ++k) {  // bent out of their planes, unevenly
+  for (std::size_t k = 0; k < p.size(); ++k) {
     p[k].x() += 0.0013f * static_cast<float>((k * 3) % 7);
     p[k].y() += 0.0021f * static_cast<float>((k * 7) % 5);
     p[k].z() += 0.0017f * static_cast<float>((k * 5) % 11);
   }
+  return p;
+}
+
+Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
+
+// Strands of one size go through the lane code eight at a time, the rest one at a time:
+// the groom value is the serial sum of strand_jaggedness_raw, bit for bit.
+TEST(Jaggedness, LanesGiveTheSerialBits) {
+  const Groom g = ragged_groom();
+  const metrics::RestInfo rest(g);
+  EXPECT_EQ(rest.jagged_grouped.size(), 16u);  // 8 of the 12-vertex strands, 8 of the 13
+  EXPECT_EQ(rest.jagged_alone.size(), 14u);
+  const std::vector<Vec4f> p = perturbed(g);
   double serial = 0.0;
   for (std::size_t s = 0; s < g.strand_count(); ++s)
     serial += metrics::strand_jaggedness_raw(std::span<const Vec4f>(p).subspan(g.strand_begin(s), g.strand_size(s))) -
@@ -55,6 +82,56 @@ TEST(Jaggedness, LanesGiveTheSerialBits) {
   serial /= static_cast<double>(g.strand_count());
   EXPECT_GT(serial, 0.0);
   EXPECT_EQ(metrics::jaggedness(rest, p), serial);
+}
+
+// The other metrics run as vector loops over the whole groom; each gives the bits of its
+// definition computed vertex by vertex and strand by strand, with Eigen, in order.
+TEST(Metrics, VectorLoopsGiveTheSerialBits) {
+  const Groom g = ragged_groom();
+  const metrics::RestInfo rest(g);
+  const std::vector<Vec4f> p = perturbed(g);
+  double sum = 0.0, max = 0.0;
+  std::size_t edges = 0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s)
+    for (std::size_t i = g.strand_begin(s) + 1; i < g.strand_begin(s) + g.strand_size(s); ++i) {
+      const double e = std::abs((xyz(p[i]) - xyz(p[i - 1])).norm() - rest.rest_length[i]) / rest.rest_length[i];
+      sum += e * e;
+      max = std::max(max, e);
+      ++edges;
+    }
+  const metrics::LengthError le = metrics::length_error(rest, p);
+  EXPECT_GT(max, 0.0);
+  EXPECT_EQ(le.max, max);
+  EXPECT_EQ(le.rms, std::sqrt(sum / static_cast<double>(edges)));
+
+  // rest_shape_error: a sum over 303 vertices rounds away most one-ulp differences in its
+  // terms, so it is checked on many head poses and on a two-vertex strand as well.
+  const Groom pair = bent_groom(1, 2);
+  const metrics::RestInfo pair_rest(pair);
+  for (int k = 0; k < 400; ++k) {
+    const float a = 0.37f * static_cast<float>(k);
+    const Affine3f head = Eigen::Translation3f(0.01f * std::sin(a), -0.02f, 0.03f * std::cos(3.0f * a)) *
+                          Eigen::AngleAxisf(a, Vec3f(std::sin(2.0f * a), 1.0f, -0.2f).normalized());
+    for (const auto& [groom, info, q] :
+         {std::tuple{&g, &rest, p}, std::tuple{&pair, &pair_rest, perturbed(pair)}}) {
+      double sum2 = 0.0;
+      for (std::size_t i = 0; i < q.size(); ++i)
+        sum2 += (xyz(q[i]) - (head * Vec3f(groom->positions[i].head<3>())).cast<double>()).squaredNorm();
+      ASSERT_EQ(metrics::rest_shape_error(*info, q, head),
+                std::sqrt(sum2 / static_cast<double>(q.size())) / info->mean_strand_length)
+          << "head pose " << k;
+    }
+  }
+
+  // Five spheres (four share a pass, then one): the last reaches deepest into the hair.
+  const std::vector<Vec4f> spheres = {Vec4f(0.1f, 0.1f, 0.1f, 0.05f), Vec4f(0.5f, 0.2f, 0.1f, 0.03f),
+                                      Vec4f(5.0f, 0.0f, 0.0f, 0.1f), Vec4f(0.3f, 0.14f, 0.2f, 0.08f),
+                                      Vec4f(0.8f, 0.1f, 0.16f, 0.15f)};
+  double deepest = 0.0;
+  for (const Vec4f& c : spheres)
+    for (const Vec4f& v : p) deepest = std::max(deepest, double(c.w()) - (xyz(v) - xyz(c)).norm());
+  EXPECT_GT(deepest, 0.0);
+  EXPECT_EQ(metrics::penetration(p, spheres), deepest);
 }
 
 TEST(Jaggedness, UnchangedByRigidMotion) {
