@@ -291,7 +291,7 @@ METRIC_CLONES double rest_shape_error(const RestInfo& rest, std::span<const Vec4
                      dz = double(p[i].z()) - double(gz);
         return dx * dx + (dy * dy + dz * dz);
       },
-      [&](double t) { sum += t; });
+      [&](double term) { sum += term; });
   return std::sqrt(sum / static_cast<double>(p.size())) / rest.mean_strand_length;
 }
 
@@ -303,7 +303,8 @@ METRIC_INLINE void nearest2(std::span<const Vec4f> p, const Vec4f* spheres, doub
   LaneVec lane_min[M];
   for (int k = 0; k < M; ++k) lane_min[k] = LaneVec{} + std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < whole; i += kLanes) {
-    const std::size_t begin[kLanes] = {i, i + 1, i + 2, i + 3, i + 4, i + 5, i + 6, i + 7};
+    std::size_t begin[kLanes];
+    for (int l = 0; l < kLanes; ++l) begin[l] = i + static_cast<std::size_t>(l);
     LanePoints v;
     lane_points(p, begin, 0, v);
     for (int k = 0; k < M; ++k) {
