@@ -347,8 +347,17 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     const bool ref_ok = lanes[0].running;
     enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFrameMetrics };
     std::vector<std::array<double, kFrameMetrics + 1>> values(lanes.size());  // length: rms, max
-    pool.parallel_for(lanes.size() * kFrameMetrics, [&](std::size_t b, std::size_t e) {
+    // One more task: the reference's violence for the snapshots (below), which would
+    // otherwise run alone on this thread while the pool waits.
+    const std::size_t metric_tasks = lanes.size() * kFrameMetrics;
+    double violence = 0.0;
+    pool.parallel_for(metric_tasks + 1, [&](std::size_t b, std::size_t e) {
       for (std::size_t task = b; task < e; ++task) {
+        if (task == metric_tasks) {
+          if (ref_ok)
+            violence = relative_kinetic_energy(lanes[0].model->positions(), ref_prev, in.head, in.head_prev, sc.dt);
+          continue;
+        }
         const std::size_t i = task / kFrameMetrics;
         if (!lanes[i].running) continue;
         const auto p = lanes[i].model->positions();
@@ -388,7 +397,6 @@ std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, T
     // that has stopped has none there); the final frame is the last one each lane ran.
     if (ref_ok) {
       const auto ref_p = lanes[0].model->positions();
-      const double violence = relative_kinetic_energy(ref_p, ref_prev, in.head, in.head_prev, sc.dt);
       std::copy(ref_p.begin(), ref_p.end(), ref_prev.begin());
       if (violence > max_violence) {
         max_violence = violence;
