@@ -82,7 +82,11 @@ struct Block {
       __m512 r[16];
       for (int l = 0; l < 16; ++l) r[l] = _mm512_maskz_loadu_ps(tail, run[l] + k0);
       transpose16(r);
-      for (int j = 0; j < take; ++j) _mm512_storeu_ps(rows + (k0 + j) * W, r[j]);
+      // Unrolled, so that the rows are stored from registers: as a loop GCC copied the
+      // transposed rows to the stack and on with `rep movsq` (issue 10).
+#pragma GCC unroll 16
+      for (int j = 0; j < 16; ++j)
+        if (j < take) _mm512_storeu_ps(rows + (k0 + j) * W, r[j]);
     }
   }
   void load(V3* dst, const std::vector<Vec3f>& src) const {
