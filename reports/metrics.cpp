@@ -89,6 +89,7 @@ METRIC_INLINE void edge_chunked(const Groom& g, std::size_t end, Term term, Add 
 RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
     : groom(&rest),
       rest_length(rest_edge_lengths(rest)),
+      edge_count(0),
       mean_strand_length(hairbench::mean_strand_length(rest)),
       head_extent(0.0),
       simulated_strands(std::min(simulated, rest.strand_count())) {
@@ -97,6 +98,7 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
     rest_jaggedness[s] = strand_jaggedness_raw(
         std::span(rest.positions).subspan(rest.strand_begin(s), rest.strand_size(s)));
     head_extent = std::max(head_extent, xyz(rest.positions[rest.strand_begin(s)]).norm());
+    edge_count += std::max<std::size_t>(rest.strand_size(s), 1) - 1;
   }
   group_for_lanes(rest, jagged_grouped, jagged_alone);
 }
@@ -266,8 +268,7 @@ METRIC_CLONES LengthError length_error(const RestInfo& rest, std::span<const Vec
         sum += e * e;
         out.max = std::max(out.max, e);
       });
-  std::size_t edges = 0;
-  for (std::size_t s = 0; s < g.strand_count(); ++s) edges += std::max<std::size_t>(g.strand_size(s), 1) - 1;
+  const std::size_t edges = rest.edge_count;
   out.rms = edges ? std::sqrt(sum / static_cast<double>(edges)) : 0.0;
   return out;
 }

@@ -20,6 +20,7 @@ struct RestInfo {
   explicit RestInfo(const Groom& rest, std::size_t simulated_strands = SIZE_MAX);
   const Groom* groom;
   std::vector<float> rest_length;        // per edge, indexed by its second vertex
+  std::size_t edge_count;                // edges of all strands (vertices less one per strand)
   double mean_strand_length;             // L-bar
   std::vector<double> rest_jaggedness;   // per strand, raw (not rest-subtracted)
   // The strands jaggedness computes several at a time (one size >= 4, in groups of its

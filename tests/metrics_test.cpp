@@ -12,17 +12,20 @@
 namespace hairbench {
 namespace {
 
-// A gently bent strand in the xy plane: a quarter circle arc of radius 0.2.
+// Strand s of n vertices: a gently bent strand in the xy plane, a quarter circle arc of
+// radius 0.2, moved along x and z by s.
+std::vector<Vec3f> bent_strand(int s, int n) {
+  std::vector<Vec3f> pts;
+  for (int i = 0; i < n; ++i) {
+    const float a = 0.5f * float(M_PI) * float(i) / float(n - 1);
+    pts.emplace_back(0.2f * std::sin(a) + 0.05f * float(s), 0.2f * std::cos(a), 0.01f * float(s));
+  }
+  return pts;
+}
+
 Groom bent_groom(int strands = 3, int n = 12) {
   Groom g;
-  for (int s = 0; s < strands; ++s) {
-    std::vector<Vec3f> pts;
-    for (int i = 0; i < n; ++i) {
-      const float a = 0.5f * float(M_PI) * float(i) / float(n - 1);
-      pts.emplace_back(0.2f * std::sin(a) + 0.05f * float(s), 0.2f * std::cos(a), 0.01f * float(s));
-    }
-    g.add_strand(pts, 0);
-  }
+  for (int s = 0; s < strands; ++s) g.add_strand(bent_strand(s, n), 0);
   return g;
 }
 
@@ -42,15 +45,7 @@ TEST(Jaggedness, ZeroOnRestShape) {
 // 5 and 3 of 3 (303 vertices: not a whole number of vector lanes).
 Groom ragged_groom() {
   Groom g;
-  for (int s = 0; s < 30; ++s) {
-    const int n = s % 10 == 9 ? 3 : s % 5 == 1 ? 5 : s % 2 == 0 ? 12 : 13;
-    std::vector<Vec3f> pts;
-    for (int i = 0; i < n; ++i) {
-      const float a = 0.5f * float(M_PI) * float(i) / float(n - 1);
-      pts.emplace_back(0.2f * std::sin(a) + 0.05f * float(s), 0.2f * std::cos(a), 0.01f * float(s));
-    }
-    g.add_strand(pts, 0);
-  }
+  for (int s = 0; s < 30; ++s) g.add_strand(bent_strand(s, s % 10 == 9 ? 3 : s % 5 == 1 ? 5 : s % 2 == 0 ? 12 : 13), 0);
   return g;
 }
 
