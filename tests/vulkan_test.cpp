@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <numbers>
 
@@ -117,6 +119,38 @@ TEST(VulkanModels, RefusesAStrandBeyondSharedMemory) {
   }
 }
 
+// A discrete GPU's device buffers stay unmapped (host reads through its BAR are not
+// cached), so positions come back through a staging copy recorded once (vk::Readback).
+// HAIRBENCH_VK_STAGING=1 sends any device that way; the device computes the same either
+// way, so the positions are equal bit for bit, frame after frame.
+TEST(VulkanModels, StagedReadbackGivesTheMappedBits) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = test::builtin("shake", 25);
+  const ModelInfo* info = find_model("han_m2_vk");
+  ASSERT_NE(info, nullptr);
+  ThreadPool pool(1);
+  auto mapped = info->make(ModelContext{&pool});
+  auto staged = info->make(ModelContext{&pool});
+  mapped->reset(sc.groom, resolve_params(*info, sc, {}));
+  ::setenv("HAIRBENCH_VK_STAGING", "1", 1);
+  const bool unmapped = vk::Context::get("")->buffer(64, vk::Memory::Device).mapped() == nullptr;
+  staged->reset(sc.groom, resolve_params(*info, sc, {}));
+  ::unsetenv("HAIRBENCH_VK_STAGING");
+  EXPECT_TRUE(unmapped) << "HAIRBENCH_VK_STAGING should leave device buffers unmapped";
+  StageTimes times;
+  bool moved = false;
+  for (int f = 0; f < 30; ++f) {
+    const FrameInput in = frame_input(sc, f);
+    mapped->step(in, times);
+    staged->step(in, times);
+    const std::span<const Vec4f> a = mapped->positions(), b = staged->positions();
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size_bytes()), 0) << "frame " << f;
+    moved = moved || std::memcmp(b.data(), sc.groom.positions.data(), b.size_bytes()) != 0;
+  }
+  EXPECT_TRUE(moved) << "the scenario should move the hair";
+}
+
 using test::run_cli;
 
 // Without any Vulkan driver (the loader pointed at a missing ICD): one clear line, and
@@ -146,6 +180,27 @@ TEST(VulkanCli, UnknownDeviceIsABadArgument) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--device: no-such-gpu: no Vulkan device"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("have: 0 '"), std::string::npos) << r.out;
+}
+
+// The runner reads the models' positions from the pool's threads, several at once; with
+// staged readback each read is a queue submission, which the context serializes (on an
+// H200, unserialized ones lost the device). The staged report is the mapped one.
+TEST(VulkanCli, StagedCompareGivesTheMappedReport) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const std::string args = "compare --scenario shake --frames 4 --threads 2 --models 'han_m[123]_vk' "
+                           "--reference han_m1_vk --no-charts --out /tmp/hairbench-vk-";
+  const test::CliResult mapped = run_cli(args + "mapped");
+  ASSERT_EQ(mapped.code, 0) << mapped.out;
+  const test::CliResult staged = run_cli(args + "staged", "env HAIRBENCH_VK_STAGING=1 ");
+  ASSERT_EQ(staged.code, 0) << staged.out;
+  std::ifstream a("/tmp/hairbench-vk-mapped/report.json"), b("/tmp/hairbench-vk-staged/report.json");
+  const nlohmann::json ja = nlohmann::json::parse(a), jb = nlohmann::json::parse(b);
+  ASSERT_EQ(ja["runs"].size(), 3u);
+  ASSERT_EQ(jb["runs"].size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(ja["runs"][i]["model"], jb["runs"][i]["model"]);
+    EXPECT_EQ(ja["runs"][i]["metrics"], jb["runs"][i]["metrics"]) << ja["runs"][i]["model"];
+  }
 }
 
 // The report carries the device time and the device (timing.gpu_ms, run.device,

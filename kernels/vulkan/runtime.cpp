@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <string_view>
 
 #if defined(__SANITIZE_ADDRESS__)
 // LeakSanitizer: lavapipe (Mesa 22.3, libvulkan_lvp.so) leaks 48 bytes per run of a
@@ -148,7 +150,8 @@ VkInstance shared_instance() {
   VkInstance created = VK_NULL_HANDLE;
   const VkResult r = api.vkCreateInstance(&info, nullptr, &created);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-    throw Unavailable("Vulkan: no driver (the loader found no ICD; Debian package mesa-vulkan-drivers gives lavapipe)");
+    throw Unavailable("Vulkan: no driver (the loader found no ICD it could load; VK_LOADER_DEBUG=error,warn says "
+                      "why; Debian package mesa-vulkan-drivers gives lavapipe)");
   if (r != VK_SUCCESS) throw Unavailable(std::string("Vulkan: cannot create an instance (") + result_name(r) + ")");
   load_instance(created);
   instance = created;
@@ -279,12 +282,19 @@ void Context::init(const std::string& spec) {
 
 std::uint32_t Context::memory_type(std::uint32_t allowed, Memory where) const {
   const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const VkMemoryPropertyFlags cached = host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
   // Preferences, best first; the last entry of each list always exists for some type.
+  // Device memory the host reads through its caches (CPU devices, integrated GPUs) is
+  // taken and mapped. A discrete GPU's host-visible device memory (the PCI BAR) is not
+  // cached: on an H200, reading tressfx_ponytail_shake's 1.3 MB of guide positions
+  // through it took 50 ms a frame (25 MB/s), so there plain device memory is taken and
+  // read back through a staging copy (Readback): the whole follow-hair stage, rebuild
+  // included, then took 1 ms.
   std::vector<VkMemoryPropertyFlags> wanted;
   if (where == Memory::Device)
-    wanted = {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0};
+    wanted = {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | cached, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0};
   else
-    wanted = {host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, host};
+    wanted = {cached, host};
   for (VkMemoryPropertyFlags w : wanted)
     for (std::uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
       if ((allowed & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & w) == w) return i;
@@ -307,7 +317,9 @@ Buffer Context::buffer(VkDeviceSize size, Memory where) const {
   alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, where);
   check(api.vkAllocateMemory(device_, &alloc, nullptr, &b.memory_), "vkAllocateMemory");
   check(api.vkBindBufferMemory(device_, b.buffer_, b.memory_, 0), "vkBindBufferMemory");
-  if (memory_.memoryTypes[alloc.memoryTypeIndex].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)
+  const VkMemoryPropertyFlags flags = memory_.memoryTypes[alloc.memoryTypeIndex].propertyFlags;
+  const bool readable = where == Memory::Host || (flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+  if ((flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) && readable && !(where == Memory::Device && staging_only()))
     check(api.vkMapMemory(device_, b.memory_, 0, VK_WHOLE_SIZE, 0, &b.mapped_), "vkMapMemory");
   return b;
 }
@@ -330,8 +342,19 @@ void Context::submit_and_wait(VkCommandBuffer cmd, VkFence fence) const {
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd;
-  check(api.vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit");
-  check(api.vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  {
+    // The queue is externally synchronized (Vulkan spec, vkQueueSubmit): the runner reads
+    // several models' positions at once from the pool's threads, and on an H200 two
+    // unserialized submissions lost the device.
+    const std::lock_guard lock(queue_mutex_);
+    check(api.vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit");
+  }
+  // Finite, so that a hung device is an error rather than a process that never returns;
+  // far above any frame (a frame of Table 1's largest groom takes seconds on lavapipe).
+  constexpr std::uint64_t kTimeoutNs = 600'000'000'000;
+  const VkResult r = api.vkWaitForFences(device_, 1, &fence, VK_TRUE, kTimeoutNs);
+  if (r == VK_TIMEOUT) throw std::runtime_error("Vulkan: the device did not finish a submission within 600 s");
+  check(r, "vkWaitForFences");
 }
 
 void Context::copy(VkBuffer src, VkBuffer dst, VkDeviceSize bytes) const {
@@ -358,15 +381,38 @@ void Context::upload(Buffer& dst, const void* data, std::size_t bytes) const {
   copy(staging.handle(), dst.handle(), bytes);
 }
 
-void Context::download(const Buffer& src, void* data, std::size_t bytes) const {
-  if (bytes == 0) return;
-  if (src.mapped()) {
-    std::memcpy(data, src.mapped(), bytes);
-    return;
-  }
-  Buffer staging = buffer(bytes, Memory::Host);
-  copy(src.handle(), staging.handle(), bytes);
-  std::memcpy(data, staging.mapped(), bytes);
+std::unique_ptr<Readback> Context::readback(const Buffer& src) const {
+  std::unique_ptr<Readback> r(new Readback(*this));
+  r->size_ = src.size();
+  r->mapped_ = src.mapped();
+  if (r->mapped_) return r;
+  r->staging_ = buffer(src.size(), Memory::Host);
+  r->mapped_ = r->staging_.mapped();
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = command_pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  check(api.vkAllocateCommandBuffers(device_, &alloc, &r->cmd_), "vkAllocateCommandBuffers");
+  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  check(api.vkCreateFence(device_, &fi, nullptr, &r->fence_), "vkCreateFence");
+  // Recorded once, submitted on every fetch. The kernel's closing barrier already makes
+  // its writes visible to transfers; this one makes the copy visible to the host.
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  check(api.vkBeginCommandBuffer(r->cmd_, &begin), "vkBeginCommandBuffer");
+  const VkBufferCopy region{0, 0, src.size()};
+  api.vkCmdCopyBuffer(r->cmd_, src.handle(), r->staging_.handle(), 1, &region);
+  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  api.vkCmdPipelineBarrier(r->cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0,
+                           nullptr, 0, nullptr);
+  check(api.vkEndCommandBuffer(r->cmd_), "vkEndCommandBuffer");
+  return r;
+}
+
+bool Context::staging_only() {
+  const char* v = std::getenv("HAIRBENCH_VK_STAGING");
+  return v && *v && std::string_view(v) != "0";
 }
 
 std::unique_ptr<Kernel> Context::kernel(std::span<const std::uint32_t> spirv, std::uint32_t bindings,
@@ -511,6 +557,21 @@ std::optional<double> Kernel::last_ms() const {
         "vkGetQueryPoolResults");
   const std::uint64_t ticks = (t[1] - t[0]) & ctx_.timestamp_mask_;
   return static_cast<double>(ticks) * ctx_.timestamp_period_ns_ * 1e-6;
+}
+
+// ----------------------------------------------------------------------------- Readback
+
+Readback::~Readback() {
+  const VkDevice d = ctx_.device_;
+  api.vkDestroyFence(d, fence_, nullptr);
+  if (cmd_) api.vkFreeCommandBuffers(d, ctx_.command_pool_, 1, &cmd_);
+}
+
+void Readback::fetch(void* data, std::size_t bytes) {
+  if (bytes > size_) throw std::logic_error("Readback::fetch: more bytes than the buffer holds");
+  if (bytes == 0) return;
+  if (cmd_) ctx_.submit_and_wait(cmd_, fence_);
+  std::memcpy(data, mapped_, bytes);
 }
 
 }  // namespace hairbench::vk

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -61,9 +62,11 @@ class Buffer {
   void* mapped_ = nullptr;
 };
 
-// Where a buffer lives: on the device (mapped too when the device offers host-visible
-// device memory, as CPU devices and resizable-BAR GPUs do), or in host memory the
-// device reads and writes (per-frame uploads, readback).
+// Where a buffer lives: on the device (mapped too where the host reads device memory
+// through its caches, as on CPU devices and integrated GPUs; never through a discrete
+// GPU's uncached BAR), or in host memory the device reads and writes (per-frame uploads,
+// staging). HAIRBENCH_VK_STAGING=1 (tests) leaves device buffers unmapped on any device,
+// so that lavapipe runs the staging paths a discrete GPU takes.
 enum class Memory { Device, Host };
 
 // A compute pipeline over `bindings` storage buffers (set 0) with specialization
@@ -102,6 +105,29 @@ class Kernel {
   std::uint32_t bindings_ = 0;
 };
 
+// Brings a device buffer's contents to the host: straight from the mapping where the
+// buffer is mapped, else through a host buffer and a copy recorded once and submitted on
+// each fetch. Made by Context::readback; must not outlive the buffer's memory (make a new
+// one when the buffer is replaced).
+class Readback {
+ public:
+  ~Readback();
+  Readback(const Readback&) = delete;
+  Readback& operator=(const Readback&) = delete;
+  // Copies the buffer's first `bytes` out; waits for the copy.
+  void fetch(void* data, std::size_t bytes);
+
+ private:
+  friend class Context;
+  explicit Readback(const Context& ctx) : ctx_(ctx) {}
+  const Context& ctx_;
+  VkDeviceSize size_ = 0;
+  const void* mapped_ = nullptr;  // the buffer's own mapping, or staging_'s
+  Buffer staging_;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+};
+
 class Context {
  public:
   // The shared context for a device: `spec` empty picks the first discrete GPU, else
@@ -117,8 +143,8 @@ class Context {
   Buffer buffer(VkDeviceSize size, Memory where) const;
   // Copies bytes into the buffer (through a staging buffer when it is not mapped).
   void upload(Buffer& dst, const void* data, std::size_t bytes) const;
-  // Copies the buffer's first `bytes` out (through a staging buffer when not mapped).
-  void download(const Buffer& src, void* data, std::size_t bytes) const;
+  // The way back for a buffer the host reads repeatedly (see Readback).
+  std::unique_ptr<Readback> readback(const Buffer& src) const;
 
   std::unique_ptr<Kernel> kernel(std::span<const std::uint32_t> spirv, std::uint32_t bindings,
                                  std::span<const std::uint32_t> specialization) const;
@@ -126,6 +152,8 @@ class Context {
  private:
   friend class Buffer;
   friend class Kernel;
+  friend class Readback;
+  static bool staging_only();
   Context() = default;
   void init(const std::string& spec);
   VkCommandBuffer begin_once() const;
@@ -139,6 +167,7 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   std::uint32_t queue_family_ = 0;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  mutable std::mutex queue_mutex_;  // vkQueueSubmit from several threads (Readback::fetch)
   VkPhysicalDeviceMemoryProperties memory_{};
   double timestamp_period_ns_ = 0.0;  // 0: the queue has no timestamps
   std::uint64_t timestamp_mask_ = 0;

@@ -99,8 +99,9 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   }
   substeps_ = params.get_int("substeps");
 
-  // The kernel holds buffers by handle: drop it before the buffers it points at.
+  // The kernel and the readback hold buffers by handle: drop them before the buffers.
   kernel_.reset();
+  readback_.reset();
   pos_ = device_buffer(ctx, rest.positions);
   prev_ = device_buffer(ctx, rest.positions);
   // Method 2's frames persist across iterations and frames; they start at rest.
@@ -122,6 +123,7 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   kernel_->bind(bound);
   const std::uint32_t per_group = HAN_VK_GROUP_SIZE / lanes_;
   kernel_->record_dispatch(static_cast<std::uint32_t>((strand_count_ + per_group - 1) / per_group));
+  readback_ = ctx.readback(pos_);
 
   host_pos_ = rest.positions;
   host_current_ = true;
@@ -169,7 +171,7 @@ void HanVkModel::step(const FrameInput& in, StageTimes& times) {
 
 std::span<const Vec4f> HanVkModel::positions() const {
   if (!host_current_) {
-    context_->download(pos_, host_pos_.data(), host_pos_.size() * sizeof(Vec4f));
+    readback_->fetch(host_pos_.data(), host_pos_.size() * sizeof(Vec4f));
     host_current_ = true;
   }
   return host_pos_;

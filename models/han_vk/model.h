@@ -37,6 +37,7 @@ class HanVkModel final : public HairModel {
   han::Method method_;
   std::shared_ptr<vk::Context> context_;
   std::unique_ptr<vk::Kernel> kernel_;
+  std::unique_ptr<vk::Readback> readback_;  // pos_ to host_pos_
   vk::Buffer pos_, prev_, rot_, rest_, rest_local_, rest_rot_, strands_, regions_, frame_, spheres_;
   std::size_t strand_count_ = 0;
   std::uint32_t lanes_ = 1;
