@@ -324,13 +324,25 @@ Buffer Context::buffer(VkDeviceSize size, Memory where) const {
   return b;
 }
 
-VkCommandBuffer Context::begin_once() const {
+VkCommandBuffer Context::new_command_buffer() const {
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = command_pool_;
   alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   alloc.commandBufferCount = 1;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   check(api.vkAllocateCommandBuffers(device_, &alloc, &cmd), "vkAllocateCommandBuffers");
+  return cmd;
+}
+
+VkFence Context::new_fence() const {
+  VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence f = VK_NULL_HANDLE;
+  check(api.vkCreateFence(device_, &info, nullptr, &f), "vkCreateFence");
+  return f;
+}
+
+VkCommandBuffer Context::begin_once() const {
+  const VkCommandBuffer cmd = new_command_buffer();
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   check(api.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
@@ -362,9 +374,7 @@ void Context::copy(VkBuffer src, VkBuffer dst, VkDeviceSize bytes) const {
   const VkBufferCopy region{0, 0, bytes};
   api.vkCmdCopyBuffer(cmd, src, dst, 1, &region);
   check(api.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence = VK_NULL_HANDLE;
-  check(api.vkCreateFence(device_, &fi, nullptr, &fence), "vkCreateFence");
+  const VkFence fence = new_fence();
   submit_and_wait(cmd, fence);
   api.vkDestroyFence(device_, fence, nullptr);
   api.vkFreeCommandBuffers(device_, command_pool_, 1, &cmd);
@@ -388,13 +398,8 @@ std::unique_ptr<Readback> Context::readback(const Buffer& src) const {
   if (r->mapped_) return r;
   r->staging_ = buffer(src.size(), Memory::Host);
   r->mapped_ = r->staging_.mapped();
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = command_pool_;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  check(api.vkAllocateCommandBuffers(device_, &alloc, &r->cmd_), "vkAllocateCommandBuffers");
-  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  check(api.vkCreateFence(device_, &fi, nullptr, &r->fence_), "vkCreateFence");
+  r->cmd_ = new_command_buffer();
+  r->fence_ = new_fence();
   // Recorded once, submitted on every fetch. The kernel's closing barrier already makes
   // its writes visible to transfers; this one makes the copy visible to the host.
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
@@ -463,13 +468,8 @@ std::unique_ptr<Kernel> Context::kernel(std::span<const std::uint32_t> spirv, st
   ai.pSetLayouts = &k->set_layout_;
   check(api.vkAllocateDescriptorSets(device_, &ai, &k->set_), "vkAllocateDescriptorSets");
 
-  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cai.commandPool = command_pool_;
-  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cai.commandBufferCount = 1;
-  check(api.vkAllocateCommandBuffers(device_, &cai, &k->cmd_), "vkAllocateCommandBuffers");
-  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  check(api.vkCreateFence(device_, &fi, nullptr, &k->fence_), "vkCreateFence");
+  k->cmd_ = new_command_buffer();
+  k->fence_ = new_fence();
   if (timestamp_period_ns_ > 0.0) {
     VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;

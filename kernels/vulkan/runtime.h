@@ -156,7 +156,9 @@ class Context {
   static bool staging_only();
   Context() = default;
   void init(const std::string& spec);
-  VkCommandBuffer begin_once() const;
+  VkCommandBuffer new_command_buffer() const;  // a primary one from command_pool_
+  VkFence new_fence() const;                    // unsignalled
+  VkCommandBuffer begin_once() const;           // new_command_buffer(), begun for one submission
   void submit_and_wait(VkCommandBuffer cmd, VkFence fence) const;
   void copy(VkBuffer src, VkBuffer dst, VkDeviceSize bytes) const;
   std::uint32_t memory_type(std::uint32_t allowed, Memory where) const;
