@@ -1,9 +1,12 @@
 // Han & Harada 2012 Algorithm 1 as one fused pass per block of strands, structure of
 // arrays: a block holds kLanes strands of equal vertex count, field by field and vertex by
 // vertex ([field][vertex][lane]), so one vector instruction advances kLanes strands.
-// A block stays in L1 through a whole frame: every substep's integration, global shape,
-// local shape / edge length iterations and collisions, then one write of the positions
-// back to the groom-ordered float4 array (the HairModel interface).
+// A block stays in L1 through a whole frame: its positions are read from the
+// groom-ordered float4 array (the HairModel interface) into rows, then every substep's
+// integration, global shape, local shape / edge length iterations and collisions run,
+// then one write puts the positions back. The positions live only in that array, not in
+// the block as well (issue 10): method 3's state on the Table 1 model-1 groom is 9.3 MiB
+// instead of 12.7, at the cost of a transpose per row per frame.
 //
 // Every lane performs the same floating-point operations in the same order as the
 // per-strand kernels of strand_kernels.cpp (with Eigen's evaluation order written out:
@@ -25,11 +28,10 @@ inline constexpr std::uint32_t kNoStrand = 0xffffffffu;
 
 // Fields of a block, each n rows of kLanes floats. Method 1 adds the rest positions of
 // every vertex in its parent's frame (^{i-1}P_i^0, Algorithm 2); method 2 adds those and
-// the persistent frames (Algorithm 4).
+// the persistent frames (Algorithm 4). The positions and inverse masses are not fields:
+// they are the float4 array's (Block::in_offset).
 enum Field : int {
-  PX, PY, PZ,  // positions
   QX, QY, QZ,  // previous positions (Verlet)
-  IW,          // inverse mass (0 = pinned)
   RX, RY, RZ,  // rest positions in the head's rest frame
   RL,          // rest length of edge (i-1, i), 0 at the root
   kM3Fields,
@@ -48,8 +50,9 @@ inline constexpr std::size_t block_floats(int method, int n) {
   return static_cast<std::size_t>(field_count(method) * n + (method == 3 ? 0 : kRestFrameRows)) * kLanes;
 }
 // Floats of per-thread scratch a block of n vertices needs (method 3's head-rotated rest
-// edges or method 2's copy of the frames, and the local constraint's mass weights).
-inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(6 * n) * kLanes; }
+// edges or method 2's copy of the frames, the local constraint's mass weights, and the
+// positions and inverse masses read from the float4 array).
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(10 * n) * kLanes; }
 
 // What a row (one vertex of every lane) holds: free and pinned vertices need different
 // work, and most rows are all one or the other.
@@ -60,6 +63,9 @@ struct Block {
   int n;                            // vertices per strand
   int method;                       // 1, 2 or 3 (Han & Harada §4.2)
   const std::uint32_t* out_offset;  // per lane: first vertex in the float4 output, or kNoStrand
+  // Per lane: the first vertex in the float4 array to read the positions from. A lane
+  // without a strand of its own (kNoStrand out) reads the strand it repeats.
+  const std::uint32_t* in_offset;
   const RowKind* rows;              // n entries
 };
 
@@ -89,13 +95,14 @@ using Frame = soa::BlockFrame<Substep>;
 enum Stage : int { kIntegrate, kGlobal, kLocal, kLength, kCollision, kStageCount };
 
 // Advances `count` (1..kMaxBlocks) blocks of one vertex count, method and parameter set
-// by one frame, side by side, and writes their positions to out (float4 per vertex).
+// by one frame, side by side, reading their positions from pos (float4 per vertex, w the
+// inverse mass) and writing them back there.
 // Two blocks at a time give method 1's serial chains something to overlap with; scratch
 // holds count * scratch_floats(n) floats. feed holds the next job's memory, requested
 // stage by stage. With stage_ns non-null, adds the nanoseconds spent in each Stage (a
 // few clock reads per substep; callers pass it for a sample of blocks only).
 inline constexpr int kMaxBlocks = 2;
-using FrameFn = void (*)(const Block* blocks, int count, const BlockParams& params, const Frame& frame, float* out,
+using FrameFn = void (*)(const Block* blocks, int count, const BlockParams& params, const Frame& frame, float* pos,
                          float* scratch, soa::LineFeed& feed, std::int64_t* stage_ns);
 
 // The variant for this CPU: x86-64-v4 (AVX-512) when the CPU has it, else the baseline

@@ -668,12 +668,18 @@ void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {
   }
 }
 
-// The block's positions to the groom-ordered float4 array (w: the inverse mass, as the
-// groom's).
-void write_back(const Rows& r, int n, const std::uint32_t* offset, float* out) {
+// The block's positions and inverse masses from the groom-ordered float4 array into rows.
+void read_in(float* px, float* py, float* pz, float* iw, int n, const std::uint32_t* offset, const float* pos) {
+  const float* lane_in[W];
+  for (int l = 0; l < W; ++l) lane_in[l] = pos + 4 * static_cast<std::size_t>(offset[l]);
+  soa::read_rows_float4(lane_in, n, px, py, pz, iw);
+}
+
+// The block's positions back to the float4 array (w: the inverse mass, as read).
+void write_back(const Rows& r, int n, const std::uint32_t* offset, float* pos) {
   float* lane_out[W];
   for (int l = 0; l < W; ++l)
-    lane_out[l] = offset[l] == kNoStrand ? nullptr : out + 4 * static_cast<std::size_t>(offset[l]);
+    lane_out[l] = offset[l] == kNoStrand ? nullptr : pos + 4 * static_cast<std::size_t>(offset[l]);
   soa::write_rows_float4(r.px, r.py, r.pz, r.iw, n, lane_out);
 }
 
@@ -688,7 +694,7 @@ struct Ctx {
   std::size_t rows;
 };
 
-void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f, float* out, float* scratch,
+void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f, float* pos, float* scratch,
            soa::LineFeed& feed, std::int64_t* stage_ns) {
   const int n = blocks[0].n, method = blocks[0].method;
   const std::size_t rows = static_cast<std::size_t>(n) * W;
@@ -698,8 +704,11 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
     float* d = blocks[j].data;
     auto field = [&](int k) { return d + static_cast<std::size_t>(k) * rows; };
     float* sc = scratch + static_cast<std::size_t>(j) * scratch_floats(n);
-    c[j] = Ctx{{field(PX), field(PY), field(PZ), field(QX), field(QY), field(QZ), field(IW), field(RX), field(RY),
-                field(RZ), field(RL)},
+    // Scratch rows 0-3: method 3's rest edges or method 2's frames; 4-5: the mass
+    // weights; 6-9: the positions and inverse masses.
+    float *px = sc + 6 * rows, *py = sc + 7 * rows, *pz = sc + 8 * rows, *iw = sc + 9 * rows;
+    read_in(px, py, pz, iw, n, blocks[j].in_offset, pos);
+    c[j] = Ctx{{px, py, pz, field(QX), field(QY), field(QZ), iw, field(RX), field(RY), field(RZ), field(RL)},
                blocks[j].rows,
                d,
                sc,
@@ -794,7 +803,7 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
       done(kCollision);
     }
   }
-  for (int j = 0; j < count; ++j) write_back(c[j].r, n, blocks[j].out_offset, out);
+  for (int j = 0; j < count; ++j) write_back(c[j].r, n, blocks[j].out_offset, pos);
   feed.finish();
 }
 

@@ -87,6 +87,41 @@ inline void write_rows_float4(const float* x, const float* y, const float* z, co
   }
 #endif
 }
+
+// The inverse of write_rows_float4: lane_in[l] + 4 i (float4 per vertex, every lane
+// non-null) to rows 0..n-1 of x, y, z and w. With AVX-512, each row's sixteen float4
+// loads go into four vectors (lane 4k + m in v[m]'s 128-bit part k) and a 4x4 transpose
+// within each 128-bit part gives the rows.
+inline void read_rows_float4(const float* const* lane_in, int n, float* x, float* y, float* z, float* w) {
+#if defined(__AVX512F__)
+  for (int i = 0; i < n; ++i) {
+    const std::size_t o = 4 * static_cast<std::size_t>(i);
+    __m512 v[4];
+    for (int m = 0; m < 4; ++m) {
+      const __m512 k0 = _mm512_castps128_ps512(_mm_loadu_ps(lane_in[m] + o));
+      const __m512 k1 = _mm512_insertf32x4(k0, _mm_loadu_ps(lane_in[4 + m] + o), 1);
+      const __m512 k2 = _mm512_insertf32x4(k1, _mm_loadu_ps(lane_in[8 + m] + o), 2);
+      v[m] = _mm512_insertf32x4(k2, _mm_loadu_ps(lane_in[12 + m] + o), 3);
+    }
+    const __m512 a0 = _mm512_unpacklo_ps(v[0], v[1]), a1 = _mm512_unpacklo_ps(v[2], v[3]);
+    const __m512 a2 = _mm512_unpackhi_ps(v[0], v[1]), a3 = _mm512_unpackhi_ps(v[2], v[3]);
+    _mm512_storeu_ps(x + i * kRowLanes, _mm512_shuffle_ps(a0, a1, _MM_SHUFFLE(1, 0, 1, 0)));
+    _mm512_storeu_ps(y + i * kRowLanes, _mm512_shuffle_ps(a0, a1, _MM_SHUFFLE(3, 2, 3, 2)));
+    _mm512_storeu_ps(z + i * kRowLanes, _mm512_shuffle_ps(a2, a3, _MM_SHUFFLE(1, 0, 1, 0)));
+    _mm512_storeu_ps(w + i * kRowLanes, _mm512_shuffle_ps(a2, a3, _MM_SHUFFLE(3, 2, 3, 2)));
+  }
+#else
+  for (int l = 0; l < kRowLanes; ++l) {
+    const float* in = lane_in[l];
+    for (int i = 0; i < n; ++i) {
+      x[i * kRowLanes + l] = in[4 * i];
+      y[i * kRowLanes + l] = in[4 * i + 1];
+      z[i * kRowLanes + l] = in[4 * i + 2];
+      w[i * kRowLanes + l] = in[4 * i + 3];
+    }
+  }
+#endif
+}
 #pragma GCC diagnostic pop
 
 }  // namespace

@@ -91,6 +91,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
       const bool used = i + static_cast<std::size_t>(l) < j;
       strands[l] = order[used ? i + l : j - 1];
       b.out_offset[l] = used ? rest.strand_begin(strands[l]) : soa::kNoStrand;
+      b.in_offset[l] = rest.strand_begin(strands[l]);
       b.strand[l] = used ? strands[l] : soa::kNoStrand;
     }
     floats += soa::block_floats(b.method, n);
@@ -124,11 +125,9 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
       for (int i = 0; i < b.n; ++i) {
         const Vec4f& p0 = rest.positions[v0 + i];
         for (int c = 0; c < 3; ++c) {
-          at(soa::PX + c, i, l) = p0[c];
           at(soa::QX + c, i, l) = p0[c];
           at(soa::RX + c, i, l) = p0[c];
         }
-        at(soa::IW, i, l) = p0.w();
         at(soa::RL, i, l) = rest_length[v0 + i];
         if (b.method == 3) continue;
         for (int c = 0; c < 3; ++c) at(soa::LX + c, i, l) = rest_local[v0 + i][c];
@@ -191,6 +190,8 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   for (const BlockInfo& b : blocks_) max_block = std::max(max_block, soa::block_floats(b.method, b.n));
   backup_stride_ = soa::kMaxBlocks * max_block;
   backup_.assign(backup_stride_ * static_cast<std::size_t>(threads), 0.0f);
+  pos_backup_stride_ = soa::kMaxBlocks * W * static_cast<std::size_t>(max_n);
+  pos_backup_.assign(pos_backup_stride_ * static_cast<std::size_t>(threads), Vec4f::Zero());
   prev_tmp_.assign(static_cast<std::size_t>(max_n) * static_cast<std::size_t>(threads), Vec4f::Zero());
   sleep_.reset(rest.strand_count());
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
@@ -216,9 +217,15 @@ void HanFusedModel::feed_job(const Job& job, kernels::soa::LineFeed& feed) const
 
 void HanFusedModel::run_thread(int t) {
   ThreadState& ts = threads_[static_cast<std::size_t>(t)];
-  float* out = pos_.data()->data();
+  float* pos = pos_.data()->data();
   float* scratch = scratch_.data() + scratch_stride_ * static_cast<std::size_t>(t);
   float* backup = backup_.data() + backup_stride_ * static_cast<std::size_t>(t);
+  Vec4f* pos_backup = pos_backup_.data() + pos_backup_stride_ * static_cast<std::size_t>(t);
+  // Where sleeper lane l of the job's block i keeps its positions, which the kernel
+  // writes back with the rest of the block.
+  auto saved_pos = [pos_backup](int i, int l, int n) {
+    return pos_backup + (static_cast<std::size_t>(i) * W + static_cast<std::size_t>(l)) * static_cast<std::size_t>(n);
+  };
   kernels::soa::LineFeed feed;
   for (std::size_t j = ts.first; j < ts.last; ++j) {
     const Job& job = jobs_[j];
@@ -229,7 +236,8 @@ void HanFusedModel::run_thread(int t) {
     int asleep = 0, strands = 0;
     for (int i = 0; i < job.count; ++i) {
       const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
-      blocks[i] = {data_.data() + b.offset, b.n, b.method, b.out_offset.data(), row_kinds_.data() + b.row_kinds};
+      blocks[i] = {data_.data() + b.offset, b.n, b.method, b.out_offset.data(), b.in_offset.data(),
+                   row_kinds_.data() + b.row_kinds};
       if (!calm_) continue;
       for (std::uint32_t s : b.strand)
         if (s != soa::kNoStrand) {
@@ -242,16 +250,19 @@ void HanFusedModel::run_thread(int t) {
       for (int i = 0; i < job.count; ++i) {
         const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
         std::copy_n(blocks[i].data, soa::block_floats(b.method, b.n), backup + i * backup_stride_ / soa::kMaxBlocks);
+        for (int l = 0; l < W; ++l)
+          if (b.strand[l] != soa::kNoStrand && sleep_.asleep(b.strand[l]))
+            std::copy_n(pos_.data() + b.out_offset[l], b.n, saved_pos(i, l, b.n));
       }
     if (j + 1 < ts.last)
       feed_job(jobs_[j + 1], feed);
     else
       feed.clear();
     if (!job.sampled) {
-      kernel_(blocks, job.count, p, frame_, out, scratch, feed, nullptr);
+      kernel_(blocks, job.count, p, frame_, pos, scratch, feed, nullptr);
     } else {
       const auto start = std::chrono::steady_clock::now();
-      kernel_(blocks, job.count, p, frame_, out, scratch, feed, ts.stage_ns.data());
+      kernel_(blocks, job.count, p, frame_, pos, scratch, feed, ts.stage_ns.data());
       ts.sampled_ns +=
           std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
     }
@@ -264,13 +275,7 @@ void HanFusedModel::run_thread(int t) {
       for (int l = 0; l < W; ++l) {
         if (b.strand[l] == soa::kNoStrand || !sleep_.asleep(b.strand[l])) continue;
         for (std::size_t r = 0; r < rows; ++r) blocks[i].data[r * W + l] = saved[r * W + l];
-        const float* d = blocks[i].data;
-        const std::size_t nw = static_cast<std::size_t>(b.n) * W;
-        for (int v = 0; v < b.n; ++v) {
-          Vec4f& o = pos_[b.out_offset[l] + static_cast<std::size_t>(v)];
-          const std::size_t k = static_cast<std::size_t>(v) * W + l;
-          o = Vec4f(d[soa::PX * nw + k], d[soa::PY * nw + k], d[soa::PZ * nw + k], d[soa::IW * nw + k]);
-        }
+        std::copy_n(saved_pos(i, l, b.n), b.n, pos_.data() + b.out_offset[l]);
       }
     }
   }
@@ -291,7 +296,8 @@ void HanFusedModel::observe_sleep(int t, float dt) {
         if (s == soa::kNoStrand || sleep_.asleep(s)) continue;
         for (int v = 0; v < b.n; ++v) {
           const std::size_t k = static_cast<std::size_t>(v) * W + l;
-          prev[v] = Vec4f(d[soa::QX * nw + k], d[soa::QY * nw + k], d[soa::QZ * nw + k], d[soa::IW * nw + k]);
+          const float iw = pos_[b.out_offset[l] + static_cast<std::size_t>(v)].w();
+          prev[v] = Vec4f(d[soa::QX * nw + k], d[soa::QY * nw + k], d[soa::QZ * nw + k], iw);
         }
         const std::size_t n = static_cast<std::size_t>(b.n);
         sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(b.out_offset[l], n), std::span<const Vec4f>(prev, n), dt);

@@ -49,6 +49,7 @@ class HanFusedModel final : public HairModel {
     int n, method;
     std::uint16_t region;
     std::array<std::uint32_t, kernels::han_soa::kLanes> out_offset;
+    std::array<std::uint32_t, kernels::han_soa::kLanes> in_offset;  // Block::in_offset
     std::array<std::uint32_t, kernels::han_soa::kLanes> strand;  // groom index, or kNoStrand
   };
   // One kernel call: up to kMaxBlocks consecutive blocks of one region and vertex count.
@@ -78,12 +79,15 @@ class HanFusedModel final : public HairModel {
   bool any_global_ = false, any_local_ = false, any_length_ = false;
 
   // Sleeping strands (issue 8, core/sleep.h): a block whose strands all sleep is not
-  // run; a block with some asleep runs whole and its sleepers' lanes are put back from
-  // a copy (backup_, per thread), so they stay bit-exactly as they were.
+  // run; a block with some asleep runs whole and its sleepers' lanes and positions are
+  // put back from copies (backup_ and pos_backup_, per thread), so they stay
+  // bit-exactly as they were.
   StrandSleep sleep_;
   bool calm_ = false;
   FloatBuffer backup_;
   std::size_t backup_stride_ = 0;
+  std::vector<Vec4f> pos_backup_;
+  std::size_t pos_backup_stride_ = 0;
   std::vector<Vec4f> prev_tmp_;  // per thread, max strand length: observe()'s prev
 
   // Per-step input, filled before the parallel pass (capacity reserved in reset()).
