@@ -2,6 +2,8 @@
 
 #include "reports/metrics.h"
 
+#include "git_sha.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -66,7 +68,8 @@ std::string cpu_name() {
 }
 
 // The commit being measured: asked of git at run time (the build may be older than
-// HEAD), falling back to the commit seen at configure time.
+// HEAD), falling back to the commit the binary was built from (git_sha.h, written at
+// every build by git_sha.cmake).
 std::string git_sha() {
   std::string sha;
   if (FILE* p = popen("git -C \"" HAIRBENCH_SOURCE_DIR "\" rev-parse --short=12 HEAD 2>/dev/null", "r")) {

@@ -1,6 +1,7 @@
 // The command line's contract: bad files and bad arguments give exit code 2 and one
 // line naming what is wrong; good runs write a report that follows the schema.
 #include "cli_support.h"
+#include "git_sha.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -66,6 +67,23 @@ TEST(Cli, ListsModelsAndScenarios) {
   EXPECT_EQ(scenarios.code, 0);
   for (const char* s : {"idle", "nod", "shake", "spin_fast", "walk", "tilt_upside_down", "wind_gust", "ponytail"})
     EXPECT_NE(scenarios.out.find(s), std::string::npos) << s;
+}
+
+// Where git cannot answer at run time (no git on PATH here; on a machine that got a copy
+// of the tree without .git), the report names the commit the binary was built from, as
+// recorded at build time, not one seen at an earlier configure.
+TEST(Cli, ReportWithoutGitNamesTheBuiltCommit) {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-nogit";
+  std::filesystem::remove_all(out);
+  const hairbench::test::CliResult r =
+      run_cli("compare --scenario shake --models han_m3 --frames 1 --no-charts --out " + out.string(),
+              "PATH=/nonexistent ");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in(out / "report.json");
+  ASSERT_TRUE(in);
+  const std::string sha = nlohmann::json::parse(in)["context"]["git_sha"];
+  EXPECT_EQ(sha, HAIRBENCH_GIT_SHA);
+  EXPECT_EQ(sha.size(), 12u) << sha;  // this checkout has git: a commit, not "unknown"
 }
 
 // A short compare writes a report with the contract's fields, and --set reaches the
