@@ -1,11 +1,12 @@
 // The Vulkan backend (kernels/vulkan, models/han_vk) on whatever Vulkan device the
 // machine has (lavapipe, a CPU device, in CI): the runtime, agreement with the CPU
-// models, strands that do not fill a workgroup or overflow one, the staged readback a
-// discrete GPU takes (forced on lavapipe), and the one-line errors when there is no
-// device. The remaining method x scenario agreements and the stability sweep are in
+// models, strands that do not fill a workgroup or overflow one, the invocations per
+// strand each method takes, the staged readback a discrete GPU takes (forced on
+// lavapipe), and the one-line errors when there is no device. The remaining method x scenario agreements and the stability sweep are in
 // vulkan_agreement_test.cpp (label slow).
 #include "cli_support.h"
 #include "kernels/vulkan/runtime.h"
+#include "models/han_vk/model.h"
 #include "vulkan_support.h"
 
 #include <cmath>
@@ -150,6 +151,63 @@ TEST(VulkanModels, StagedReadbackGivesTheMappedBits) {
     moved = moved || std::memcmp(b.data(), sc.groom.positions.data(), b.size_bytes()) != 0;
   }
   EXPECT_TRUE(moved) << "the scenario should move the hair";
+}
+
+// Invocations per strand (HanVkModel::lanes): methods 2 and 3 take one per vertex; method 1,
+// whose local shape step is one serial walk per strand, takes half as many where enough
+// workgroups remain. Any choice (HAIRBENCH_VK_LANES) gives the same bits.
+std::uint32_t lanes_for(const char* model, const Scenario& sc, const Groom& g) {
+  const ModelInfo* info = find_model(model);
+  auto m = info->make(ModelContext{});
+  m->reset(g, resolve_params(*info, sc, {}));
+  return dynamic_cast<const han_vk::HanVkModel&>(*m).lanes();
+}
+
+TEST(VulkanModels, LanesFollowTheMethodAndChangeNoBits) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario full = test::builtin("shake", 1);  // 2,000 strands of 16 vertices
+  Groom dense = full.groom;  // three times the strands
+  for (int copy = 0; copy < 2; ++copy)
+    for (std::size_t s = 0; s < full.groom.strand_count(); ++s) {
+      std::vector<Vec3f> points;
+      for (std::size_t v = 0; v < full.groom.strand_size(s); ++v)
+        points.push_back(full.groom.positions[full.groom.strand_begin(s) + v].head<3>());
+      dense.add_strand(points, full.groom.strand_region[s]);
+    }
+  EXPECT_EQ(lanes_for("han_m1_vk", full, full.groom), 16u) << "8 lanes would leave 250 workgroups";
+  EXPECT_EQ(lanes_for("han_m1_vk", full, dense), 8u);
+  EXPECT_EQ(lanes_for("han_m2_vk", full, dense), 16u);
+  EXPECT_EQ(lanes_for("han_m3_vk", full, dense), 16u);
+
+  const Scenario sc = test::builtin("shake", 25);
+  for (const char* name : {"han_m1_vk", "han_m2_vk", "han_m3_vk"}) {
+    const ModelInfo* info = find_model(name);
+    auto chosen = info->make(ModelContext{});
+    chosen->reset(sc.groom, resolve_params(*info, sc, {}));
+    std::vector<std::unique_ptr<HairModel>> forced;
+    for (const char* lanes : {"4", "64"}) {
+      ::setenv("HAIRBENCH_VK_LANES", lanes, 1);
+      forced.push_back(info->make(ModelContext{}));
+      forced.back()->reset(sc.groom, resolve_params(*info, sc, {}));
+      ::unsetenv("HAIRBENCH_VK_LANES");
+      EXPECT_EQ(dynamic_cast<const han_vk::HanVkModel&>(*forced.back()).lanes(), std::stoul(lanes)) << name;
+    }
+    StageTimes times;
+    for (int f = 0; f < 20; ++f) {
+      const FrameInput in = frame_input(sc, f);
+      chosen->step(in, times);
+      const std::span<const Vec4f> a = chosen->positions();
+      for (auto& m : forced) {
+        m->step(in, times);
+        const std::span<const Vec4f> b = m->positions();
+        ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size_bytes()), 0) << name << " frame " << f;
+      }
+    }
+  }
+  // A choice the groom cannot take is refused in one line.
+  ::setenv("HAIRBENCH_VK_LANES", "2", 1);
+  EXPECT_THROW(lanes_for("han_m1_vk", sc, sc.groom), InputError);
+  ::unsetenv("HAIRBENCH_VK_LANES");
 }
 
 using test::run_cli;

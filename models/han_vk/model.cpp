@@ -9,6 +9,7 @@
 #include <array>
 #include <bit>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
 
 namespace hairbench::han_vk {
@@ -38,6 +39,33 @@ vk::Buffer device_buffer(const vk::Context& ctx, const std::vector<T>& data) {
 HanVkModel::HanVkModel(han::Method method, const ModelContext& ctx)
     : method_(method), context_(vk::Context::get(ctx.device)) {}
 
+namespace {
+
+// Invocations per strand (a power of two). Methods 2 and 3 spread a strand's vertices over
+// as many invocations as the group allows, one each where it can: their batches run in
+// parallel along the strand. Method 1's local shape step is one serial walk per strand
+// (Algorithm 3) by one invocation: with half as many invocations per strand, a workgroup
+// holds twice the walkers. That pays where the strands are long enough for the walk to
+// dominate and the groom fills the GPU with workgroups even so. Measured on an H200
+// (han_m1_vk device ms per frame, HAIRBENCH_VK_LANES sweep, default -> half): Table 1
+// model 1 0.117 -> 0.100, model 2 0.127 -> 0.104, model 3 3.80 -> 2.44, TressFX ponytail
+// (shake) 0.264 -> 0.223, mohawk 0.191 -> 0.167. Kept: shake (2,000 strands, 250
+// workgroups at half: 0.050 -> 0.057) and TestHair1 (4-vertex strands: 0.039 -> 0.043).
+// Methods 2 and 3 were fastest at their default on every groom of BM_HanVk.
+constexpr std::size_t kMethod1MinVertices = 8;
+constexpr std::size_t kMethod1MinGroups = 512;
+
+std::uint32_t choose_lanes(han::Method method, std::size_t longest, std::size_t strands) {
+  const auto widest = static_cast<std::uint32_t>(std::min<std::size_t>(HAN_VK_GROUP_SIZE, std::bit_ceil(longest)));
+  if (method != han::Method::Serial || longest < kMethod1MinVertices) return widest;
+  const std::uint32_t half = widest / 2;
+  const bool fits = (longest + half - 1) / half <= HAN_VK_VERTICES_PER_LANE;
+  const bool fills = (strands * half + HAN_VK_GROUP_SIZE - 1) / HAN_VK_GROUP_SIZE >= kMethod1MinGroups;
+  return fits && fills ? half : widest;
+}
+
+}  // namespace
+
 void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   const vk::Context& ctx = *context_;
   const std::size_t nv = rest.vertex_count();
@@ -56,9 +84,22 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
     longest = std::max(longest, n);
     strands[s] = {rest.strand_begin(s), n, rest.strand_region[s], 0};
   }
-  // One invocation per vertex of the longest strand where the group allows it; shorter
-  // strands share a workgroup (HAN_VK_GROUP_SIZE / lanes strands per group).
-  lanes_ = std::min<std::uint32_t>(HAN_VK_GROUP_SIZE, std::bit_ceil(longest));
+  lanes_ = choose_lanes(method_, longest, strand_count_);
+  if (const char* v = std::getenv("HAIRBENCH_VK_LANES"); v && *v) {
+    // Tuning override (README, Vulkan backend): any choice gives the same bits.
+    char* end = nullptr;
+    const long want = std::strtol(v, &end, 10);
+    if (*end != '\0' || want < 1 || want > HAN_VK_GROUP_SIZE || !std::has_single_bit(static_cast<unsigned long>(want)) ||
+        (longest + static_cast<std::size_t>(want) - 1) / static_cast<std::size_t>(want) > HAN_VK_VERTICES_PER_LANE)
+      throw InputError("HAIRBENCH_VK_LANES", v,
+                       "must be a power of two from " +
+                           std::to_string(std::bit_ceil((longest + HAN_VK_VERTICES_PER_LANE - 1) /
+                                                        HAN_VK_VERTICES_PER_LANE)) +
+                           " to " + std::to_string(HAN_VK_GROUP_SIZE) + " for this groom (longest strand " +
+                           std::to_string(longest) + " vertices, at most " +
+                           std::to_string(HAN_VK_VERTICES_PER_LANE) + " per invocation)");
+    lanes_ = static_cast<std::uint32_t>(want);
+  }
 
   // Rest frames and lengths exactly as the CPU model computes them (Algorithm 2).
   const std::vector<float> rest_length = rest_edge_lengths(rest);
