@@ -1,6 +1,6 @@
 # Writes OUT (a header defining HAIRBENCH_GIT_SHA) with the commit of SOURCE_DIR, at every
-# build rather than once at configure time: a report run where git cannot answer (a copy of
-# the tree without .git) names the commit the binary was built from, not an older one.
+# build rather than once at configure time, so that a report names the commit its binary
+# was built from, also after later commits and incremental builds.
 # The file is rewritten only when the commit changes, so an unchanged commit rebuilds nothing.
 execute_process(COMMAND git rev-parse --short=12 HEAD
                 WORKING_DIRECTORY "${SOURCE_DIR}"

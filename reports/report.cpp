@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <numeric>
@@ -67,19 +66,11 @@ std::string cpu_name() {
   return "unknown";
 }
 
-// The commit being measured: asked of git at run time (the build may be older than
-// HEAD), falling back to the commit the binary was built from (git_sha.h, written at
-// every build by git_sha.cmake).
-std::string git_sha() {
-  std::string sha;
-  if (FILE* p = popen("git -C \"" HAIRBENCH_SOURCE_DIR "\" rev-parse --short=12 HEAD 2>/dev/null", "r")) {
-    char buf[64] = {};
-    if (std::fgets(buf, sizeof buf, p)) sha = buf;
-    pclose(p);
-  }
-  while (!sha.empty() && (sha.back() == '\n' || sha.back() == '\r')) sha.pop_back();
-  return sha.empty() ? std::string(HAIRBENCH_GIT_SHA) : sha;
-}
+// The commit being measured: the one the binary was built from (git_sha.h, written at
+// every build by git_sha.cmake), not the checkout's HEAD at run time, which differs
+// wherever binaries outlive or travel without their checkout (on the device machine the
+// tree's copy answered 252324f for binaries built from a4fe085).
+std::string git_sha() { return HAIRBENCH_GIT_SHA; }
 
 // Snapshot coordinates to 10 micrometres: enough for a picture and for per-vertex
 // deviation (L-bar is centimetres), and it keeps the numbers short in the JSON.

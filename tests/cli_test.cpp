@@ -69,10 +69,10 @@ TEST(Cli, ListsModelsAndScenarios) {
     EXPECT_NE(scenarios.out.find(s), std::string::npos) << s;
 }
 
-// Where git cannot answer at run time (no git on PATH here; on a machine that got a copy
-// of the tree without .git), the report names the commit the binary was built from, as
-// recorded at build time, not one seen at an earlier configure.
-TEST(Cli, ReportWithoutGitNamesTheBuiltCommit) {
+// The report names the commit the binary was built from, as recorded at build time (not
+// one seen at an earlier configure, nor the checkout's HEAD at run time); it needs no git
+// at run time (none on PATH here).
+TEST(Cli, ReportNamesTheBuiltCommit) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-nogit";
   std::filesystem::remove_all(out);
   const hairbench::test::CliResult r =
