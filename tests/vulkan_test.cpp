@@ -2,8 +2,8 @@
 // machine has (lavapipe, a CPU device, in CI): the runtime, agreement with the CPU
 // models, strands that do not fill a workgroup or overflow one, the invocations per
 // strand each method takes, the staged readback a discrete GPU takes (forced on
-// lavapipe), and the one-line errors when there is no device. The remaining method x scenario agreements and the stability sweep are in
-// vulkan_agreement_test.cpp (label slow).
+// lavapipe), and the one-line errors when there is no device. The remaining method x
+// scenario agreements and the stability sweep are in vulkan_agreement_test.cpp (label slow).
 #include "cli_support.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han_vk/model.h"

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 
 namespace hairbench::han_vk {
 
@@ -55,13 +56,36 @@ namespace {
 constexpr std::size_t kMethod1MinVertices = 8;
 constexpr std::size_t kMethod1MinGroups = 512;
 
+// Whether `lanes` invocations per strand hold the longest strand (each owns at most
+// HAN_VK_VERTICES_PER_LANE vertices).
+bool lanes_hold(std::size_t lanes, std::size_t longest) {
+  return (longest + lanes - 1) / lanes <= HAN_VK_VERTICES_PER_LANE;
+}
+
 std::uint32_t choose_lanes(han::Method method, std::size_t longest, std::size_t strands) {
   const auto widest = static_cast<std::uint32_t>(std::min<std::size_t>(HAN_VK_GROUP_SIZE, std::bit_ceil(longest)));
   if (method != han::Method::Serial || longest < kMethod1MinVertices) return widest;
   const std::uint32_t half = widest / 2;
-  const bool fits = (longest + half - 1) / half <= HAN_VK_VERTICES_PER_LANE;
   const bool fills = (strands * half + HAN_VK_GROUP_SIZE - 1) / HAN_VK_GROUP_SIZE >= kMethod1MinGroups;
-  return fits && fills ? half : widest;
+  return lanes_hold(half, longest) && fills ? half : widest;
+}
+
+// HAIRBENCH_VK_LANES, a tuning override (README, Vulkan backend): any choice gives the same
+// bits. Null when unset; a value the groom cannot take is a one-line error.
+std::optional<std::uint32_t> lanes_override(std::size_t longest) {
+  const char* v = std::getenv("HAIRBENCH_VK_LANES");
+  if (!v || !*v) return std::nullopt;
+  char* end = nullptr;
+  const long want = std::strtol(v, &end, 10);
+  if (*end == '\0' && want >= 1 && want <= HAN_VK_GROUP_SIZE &&
+      std::has_single_bit(static_cast<unsigned long>(want)) && lanes_hold(static_cast<std::size_t>(want), longest))
+    return static_cast<std::uint32_t>(want);
+  const std::size_t fewest = std::bit_ceil((longest + HAN_VK_VERTICES_PER_LANE - 1) / HAN_VK_VERTICES_PER_LANE);
+  throw InputError("HAIRBENCH_VK_LANES", v,
+                   "must be a power of two from " + std::to_string(fewest) + " to " +
+                       std::to_string(HAN_VK_GROUP_SIZE) + " for this groom (longest strand " +
+                       std::to_string(longest) + " vertices, at most " + std::to_string(HAN_VK_VERTICES_PER_LANE) +
+                       " per invocation)");
 }
 
 }  // namespace
@@ -84,22 +108,7 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
     longest = std::max(longest, n);
     strands[s] = {rest.strand_begin(s), n, rest.strand_region[s], 0};
   }
-  lanes_ = choose_lanes(method_, longest, strand_count_);
-  if (const char* v = std::getenv("HAIRBENCH_VK_LANES"); v && *v) {
-    // Tuning override (README, Vulkan backend): any choice gives the same bits.
-    char* end = nullptr;
-    const long want = std::strtol(v, &end, 10);
-    if (*end != '\0' || want < 1 || want > HAN_VK_GROUP_SIZE || !std::has_single_bit(static_cast<unsigned long>(want)) ||
-        (longest + static_cast<std::size_t>(want) - 1) / static_cast<std::size_t>(want) > HAN_VK_VERTICES_PER_LANE)
-      throw InputError("HAIRBENCH_VK_LANES", v,
-                       "must be a power of two from " +
-                           std::to_string(std::bit_ceil((longest + HAN_VK_VERTICES_PER_LANE - 1) /
-                                                        HAN_VK_VERTICES_PER_LANE)) +
-                           " to " + std::to_string(HAN_VK_GROUP_SIZE) + " for this groom (longest strand " +
-                           std::to_string(longest) + " vertices, at most " +
-                           std::to_string(HAN_VK_VERTICES_PER_LANE) + " per invocation)");
-    lanes_ = static_cast<std::uint32_t>(want);
-  }
+  lanes_ = lanes_override(longest).value_or(choose_lanes(method_, longest, strand_count_));
 
   // Rest frames and lengths exactly as the CPU model computes them (Algorithm 2).
   const std::vector<float> rest_length = rest_edge_lengths(rest);
