@@ -206,13 +206,6 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
   return a;
 }
 
-std::vector<Scenario> load_builtin(FILE* note) {
-  std::vector<std::string> skipped;
-  std::vector<Scenario> scenarios = load_builtin_scenarios(&skipped);
-  for (const std::string& why : skipped) std::fprintf(note, "hairbench: skipped: %s\n", why.c_str());
-  return scenarios;
-}
-
 void print_run(const nlohmann::json& r) {
   std::string label = r["model"].get<std::string>();
   if (r.contains("knob")) {
@@ -251,7 +244,7 @@ std::vector<Scenario> load_scenarios(const CompareArgs& a) {
   // Load every scenario before running any, so a bad file fails fast. Built-in
   // scenarios whose asset is missing are skipped with a message; named ones are errors.
   std::vector<Scenario> scenarios;
-  if (a.scenarios.empty()) scenarios = load_builtin(stderr);
+  if (a.scenarios.empty()) scenarios = load_builtin_scenarios();
   for (const std::string& s : a.scenarios) scenarios.push_back(load_scenario(find_scenario(s)));
   for (const std::string& why : a.skipped) std::fprintf(stderr, "hairbench: skipped model %s\n", why.c_str());
   return scenarios;
@@ -382,7 +375,7 @@ int cmd_list(const std::vector<std::string>& args) {
     return 0;
   }
   if (args[0] == "scenarios") {
-    for (const Scenario& sc : load_builtin(stderr))
+    for (const Scenario& sc : load_builtin_scenarios())
       std::printf("%-18s %s\n", sc.name.c_str(), sc.description.c_str());
     return 0;
   }

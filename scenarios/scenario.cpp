@@ -451,7 +451,7 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
 
   const fs::path file = (fs::path(r.file()).parent_path() / g.string(key)).lexically_normal();
   std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) throw MissingAssetError(r.file(), g.key(key), "no such file: " + file.string());
+  if (!fs::is_regular_file(file, ec)) throw InputError(r.file(), g.key(key), "no such file: " + file.string());
 
   tfx::TfxAsset asset;
   try {
@@ -679,15 +679,9 @@ std::vector<fs::path> builtin_scenarios() {
   return files;
 }
 
-std::vector<Scenario> load_builtin_scenarios(std::vector<std::string>* skipped) {
+std::vector<Scenario> load_builtin_scenarios() {
   std::vector<Scenario> out;
-  for (const fs::path& file : builtin_scenarios()) {
-    try {
-      out.push_back(load_scenario(file));
-    } catch (const MissingAssetError& e) {
-      if (skipped) skipped->push_back(e.what());
-    }
-  }
+  for (const fs::path& file : builtin_scenarios()) out.push_back(load_scenario(file));
   return out;
 }
 

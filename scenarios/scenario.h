@@ -16,14 +16,6 @@
 
 namespace hairbench {
 
-// A file the scenario refers to (an imported asset) does not exist. Distinct from other
-// input errors so that the built-in scenarios can skip assets that live outside the
-// repository (../shared) where a clone does not have them.
-class MissingAssetError : public InputError {
- public:
-  using InputError::InputError;
-};
-
 // Wind over time: a direction and a strength, optionally keyed (piecewise linear in t).
 struct WindScript {
   Vec3f direction = Vec3f::UnitX();
@@ -81,10 +73,9 @@ Scenario load_scenario(const std::filesystem::path& file);
 std::filesystem::path builtin_scenario_dir();
 std::vector<std::filesystem::path> builtin_scenarios();
 
-// Loads every built-in scenario. One whose asset file is missing (MissingAssetError: the
-// TressFX scenarios read ../shared, which a clone may lack) is left out, and its one-line
-// message appended to *skipped when skipped is not null; any other error is thrown.
-std::vector<Scenario> load_builtin_scenarios(std::vector<std::string>* skipped);
+// Loads every built-in scenario. The built-in scenarios' assets ship with them
+// (scenarios/assets), so any error, a missing asset file included, is thrown.
+std::vector<Scenario> load_builtin_scenarios();
 
 // A name ("shake") or a path to a JSON file -> the file; InputError if neither exists.
 std::filesystem::path find_scenario(const std::string& name_or_path);

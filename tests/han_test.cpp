@@ -131,7 +131,7 @@ TEST(HanMethods, DeterministicAcrossRunsAndThreads) {
 }
 
 // Every shipped scenario runs every method without instability. The TressFX scenarios
-// (assets in ../shared, follow hairs) have their own, thinned run in tressfx_scenario_test.
+// (large assets, follow hairs) have their own, thinned run in tressfx_scenario_test.
 TEST(HanMethods, StableOnEveryBuiltinScenario) {
   for (const auto& file : test::procedural_builtin_scenarios()) {
     const auto runs = test::run(builtin(file.stem().string()), kHan);

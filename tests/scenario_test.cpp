@@ -77,8 +77,7 @@ TEST(BuiltinScenarios, AreTheDocumentedSetSortedByName) {
 }
 
 TEST(BuiltinScenarios, LoadEndStillAndSettleAfterTheMotion) {
-  // Scenarios whose TressFX asset is missing (no ../shared) are left out.
-  for (const Scenario& sc : load_builtin_scenarios(nullptr)) {
+  for (const Scenario& sc : load_builtin_scenarios()) {
     SCOPED_TRACE(sc.source.string());
     EXPECT_EQ(sc.name, sc.source.stem().string());
     EXPECT_FALSE(sc.description.empty());

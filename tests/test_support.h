@@ -20,9 +20,8 @@ inline Scenario builtin(const std::string& name, std::size_t keep_every = 8) {
 }
 
 // The built-in scenarios on procedural grooms: every one but the TressFX scenarios, which
-// read ../shared and rebuild follow hairs, and have their own thinned runs in
-// tressfx_scenario_test (the Halén and Plante models are not yet checked on them; see the
-// notes of issues 4 and 5).
+// are large and rebuild follow hairs, and have their own thinned runs in
+// tressfx_scenario_test (the Halén models are not checked on them there).
 inline std::vector<std::filesystem::path> procedural_builtin_scenarios() {
   std::vector<std::filesystem::path> out;
   for (const auto& file : builtin_scenarios())

@@ -24,13 +24,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kAssets = fs::path(HAIRBENCH_SHARED_DIR) / "assets" / "tressfx";
+const fs::path kAssets = HAIRBENCH_ASSET_DIR;
 const fs::path kData = fs::path(HAIRBENCH_TEST_DATA_DIR) / "tfx";
 const fs::path kCorpus = fs::path(HAIRBENCH_TEST_DATA_DIR).parent_path() / "fuzz" / "corpus";
 
-// GTEST_SKIP returns from the test body, so this has to be a macro.
-#define SKIP_IF_MISSING(path) \
-  if (!fs::exists(path)) GTEST_SKIP() << "missing " << (path).string()
+// The assets and test data ship with the repository: a missing one fails the test.
+// ASSERT returns from the test body, so this has to be a macro.
+#define ASSERT_PRESENT(path) ASSERT_TRUE(fs::exists(path)) << "missing " << (path).string()
 
 // Runs `f`, which must throw InputError, and returns its message.
 template <class F>
@@ -196,7 +196,7 @@ class ShippedAsset : public testing::TestWithParam<ShippedTfx> {};
 TEST_P(ShippedAsset, CountsPositionsAndPins) {
   const ShippedTfx& a = GetParam();
   const fs::path file = kAssets / a.file;
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxStrands t = read_tfx(file);
   EXPECT_EQ(t.version_major, a.version);
   EXPECT_EQ(t.strand_count, a.strands);
@@ -227,7 +227,7 @@ INSTANTIATE_TEST_SUITE_P(Tfx, ShippedAsset, testing::ValuesIn(kShipped),
 
 TEST(ShippedAssets, MohawkStrandUv) {
   const fs::path file = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   // Python: struct.unpack_from('<2f', data, 1139872 + 8 * s), offsetStrandUV = 1139872.
   const TfxStrands t = read_tfx(file);
   EXPECT_EQ(t.strand_uv[0], Eigen::Vector2f(0.695898652f, 0.36622107f));
@@ -242,7 +242,7 @@ TEST(ShippedAssets, PonytailSimSettings) {
   for (const Expected& e : {Expected{"front_top", 0.5, 0.2, 0.2}, Expected{"side", 0.5, 0.2, 0.2},
                             Expected{"back", 0.6, 0.2, 0.4}, Expected{"tail", 0.3, 0.1, 0.3}}) {
     const fs::path file = kAssets / "ponytail" / (std::string(e.file) + ".tfxsim");
-    SKIP_IF_MISSING(file);
+    ASSERT_PRESENT(file);
     const SimSettings s = read_tfxsim(file);
     const std::map<std::string, double> expected{{"damping", 0.1},
                                                  {"local_stiffness", e.local},
@@ -254,7 +254,7 @@ TEST(ShippedAssets, PonytailSimSettings) {
 
 TEST(ShippedAssets, TestHair1SimSettings) {
   const fs::path file = kAssets / "testhair1/TestHair1.tfxsim";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const std::map<std::string, double> expected{{"damping", 0.1},          {"local_stiffness", 0.5},
                                                {"global_stiffness", 0.1}, {"global_range", 0.2},
                                                {"length_iterations", 3},  {"local_iterations", 3}};
@@ -263,7 +263,7 @@ TEST(ShippedAssets, TestHair1SimSettings) {
 
 TEST(ShippedAssets, PonytailProject) {
   const fs::path file = kAssets / "ponytail/ponytail.tfxproj";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxProject p = read_tfxproj(file);
   EXPECT_EQ(p.project_name, "Ponytail_model");
   ASSERT_EQ(p.sections.size(), 4u);
@@ -292,7 +292,7 @@ TEST(ShippedAssets, PonytailProject) {
 
 TEST(ShippedAssets, TestHair1Project) {
   const fs::path file = kAssets / "testhair1/TestHair1.tfxproj";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxProject p = read_tfxproj(file);
   EXPECT_EQ(p.project_name, "Test_model");
   ASSERT_EQ(p.sections.size(), 1u);
@@ -308,7 +308,7 @@ TEST(ShippedAssets, TestHair1Project) {
 
 TEST(ShippedAssets, PonytailProjectLoadsInMetres) {
   const fs::path file = kAssets / "ponytail/ponytail.tfxproj";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxAsset a = load_tfx_project(file, 0.01f, 7);
   const std::size_t guides = 876 + 3066 + 517 + 474;
   EXPECT_EQ(a.groom.region_names,
@@ -353,7 +353,7 @@ TEST(ShippedAssets, PonytailProjectLoadsInMetres) {
 
 TEST(ShippedAssets, TestHair1ProjectLoads) {
   const fs::path file = kAssets / "testhair1/TestHair1.tfxproj";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxAsset a = load_tfx_project(file, 0.01f, 3);
   EXPECT_EQ(a.groom.region_names, std::vector<std::string>{"TestHair"});
   EXPECT_EQ(a.groom.strand_count(), 10027u * 5u);
@@ -370,7 +370,7 @@ TEST(ShippedAssets, TestHair1ProjectLoads) {
 // file's pins (vertices 0 and 1).
 TEST(ShippedAssets, RigidBelowPinsOnlyTheShortStrands) {
   const fs::path file = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxAsset plain = load_tfx_asset(file, 0.01f);
   const TfxAsset rigid = load_tfx_asset(file, 0.01f, 0.005);
   std::size_t pinned_whole = 0, short_strands = 0;
@@ -399,7 +399,7 @@ TEST(ShippedAssets, RigidBelowPinsOnlyTheShortStrands) {
 
 TEST(ShippedAssets, SingleTfxAsset) {
   const fs::path file = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxAsset a = load_tfx_asset(file, 0.01f);
   EXPECT_EQ(a.groom.region_names, std::vector<std::string>{"Ratboy_mohawk"});
   EXPECT_EQ(a.groom.strand_count(), 2226u);
@@ -413,8 +413,8 @@ TEST(ShippedAssets, SingleTfxAsset) {
 // ---- the small project in tests/data/tfx/mini (made by make_mini.py) -------------------
 
 TEST(MiniProject, ReadsV3AndV4) {
-  SKIP_IF_MISSING(kData / "mini/a.tfx");
-  SKIP_IF_MISSING(kData / "mini/b.tfx");
+  ASSERT_PRESENT(kData / "mini/a.tfx");
+  ASSERT_PRESENT(kData / "mini/b.tfx");
   const TfxStrands a = read_tfx(kData / "mini/a.tfx");
   EXPECT_EQ(a.version_major, 3);
   EXPECT_EQ(a.strand_count, 3u);
@@ -431,7 +431,7 @@ TEST(MiniProject, ReadsV3AndV4) {
 
 TEST(MiniProject, LoadsRegionsParamsCollidersAndFollowHairs) {
   const fs::path file = kData / "mini/mini.tfxproj";
-  SKIP_IF_MISSING(file);
+  ASSERT_PRESENT(file);
   const TfxAsset a = load_tfx_project(file, 0.01f, 1);
   EXPECT_EQ(a.groom.region_names, (std::vector<std::string>{"crown", "b"}));
   // Project iterations (4, 3) as defaults, each .tfxsim overriding what it sets.
@@ -463,7 +463,7 @@ TEST(Loaders, ReportMissingFilesAndBadScale) {
             std::string::npos);
   EXPECT_NE(input_error([] { read_tfxsim(kData / "no_such.tfxsim"); }).find("no_such.tfxsim"),
             std::string::npos);
-  SKIP_IF_MISSING(kData / "mini/a.tfx");
+  ASSERT_PRESENT(kData / "mini/a.tfx");
   EXPECT_NE(input_error([] { load_tfx_asset(kData / "mini/a.tfx", 0.0f); }).find("metres_per_unit"),
             std::string::npos);
   EXPECT_NE(input_error([] { load_tfx_asset(kData / "mini/a.tfx", NAN); }).find("metres_per_unit"),
@@ -877,8 +877,8 @@ std::string slurp(const fs::path& file) {
 // Every file of the minimised libFuzzer corpus (tests/fuzz/corpus) goes through the
 // parsers in the ordinary build: each parses or throws InputError, nothing else.
 TEST(FuzzCorpus, ReplaysWithoutCrashing) {
-  SKIP_IF_MISSING(kCorpus / "tfx");
-  SKIP_IF_MISSING(kCorpus / "text");
+  ASSERT_PRESENT(kCorpus / "tfx");
+  ASSERT_PRESENT(kCorpus / "text");
   std::size_t files = 0;
   for (const auto& entry : fs::directory_iterator(kCorpus / "tfx")) {
     const std::string data = slurp(entry.path());

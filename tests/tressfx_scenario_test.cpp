@@ -1,6 +1,6 @@
-// The TressFX scenarios (issue 3): imported assets load with the right strand counts in
-// both follow-hair modes, no free vertex starts inside a collider, a missing asset is a
-// MissingAssetError that built-in loading skips, and the ponytail project runs stably with
+// The TressFX scenarios: imported assets load with the right strand counts in both
+// follow-hair modes, no free vertex starts inside a collider, a missing asset is a one-line
+// error naming the scenario, key and file, and the ponytail project runs stably with
 // the Han models in both follow-hair modes, follow hairs moving with their guides.
 #include "core/error.h"
 #include "core/parallel.h"
@@ -26,18 +26,15 @@ using namespace hairbench;
 
 namespace {
 
-const fs::path kShared = HAIRBENCH_SHARED_DIR;
-const fs::path kPonytail = kShared / "assets/tressfx/ponytail/ponytail.tfxproj";
+const fs::path kAssets = HAIRBENCH_ASSET_DIR;
+const fs::path kPonytail = kAssets / "ponytail/ponytail.tfxproj";
 
 fs::path builtin(const std::string& name) { return builtin_scenario_dir() / (name + ".json"); }
 const std::vector<std::string> kTressfxScenarios = {"tressfx_mohawk", "tressfx_ponytail_shake",
                                                     "tressfx_ponytail_spin", "tressfx_testhair1"};
 
-// The assets live in ../shared, which a user's clone may not have.
-#define SKIP_WITHOUT(file)                                                                  \
-  do {                                                                                      \
-    if (!fs::exists(file)) GTEST_SKIP() << "TressFX asset not present: " << (file).string(); \
-  } while (0)
+// The assets ship with the repository (scenarios/assets/tressfx): a missing one fails.
+#define ASSERT_PRESENT(file) ASSERT_TRUE(fs::exists(file)) << "TressFX asset not present: " << (file).string()
 
 // A scenario file in a fresh temporary folder; `groom` is the groom object's JSON.
 fs::path write_scenario(const std::string& name, const std::string& groom) {
@@ -65,7 +62,7 @@ void expect_counts(const Scenario& sc, std::size_t guides, std::size_t per_guide
 }  // namespace
 
 TEST(TressfxScenario, PonytailCountsAndHeadFrame) {
-  SKIP_WITHOUT(kPonytail);
+  ASSERT_PRESENT(kPonytail);
   for (const char* name : {"tressfx_ponytail_shake", "tressfx_ponytail_spin"}) {
     SCOPED_TRACE(name);
     const Scenario sc = load_scenario(builtin(name));
@@ -87,12 +84,7 @@ TEST(TressfxScenario, PonytailCountsAndHeadFrame) {
 TEST(TressfxScenario, NoFreeVertexStartsInsideACollider) {
   for (const std::string& name : kTressfxScenarios) {
     SCOPED_TRACE(name);
-    Scenario sc;
-    try {
-      sc = load_scenario(builtin(name));
-    } catch (const MissingAssetError& e) {
-      GTEST_SKIP() << e.what();
-    }
+    const Scenario sc = load_scenario(builtin(name));
     // TestHair1's project has no collision spheres; the others have.
     EXPECT_EQ(sc.colliders.empty(), name == "tressfx_testhair1");
     for (const Sphere& c : sc.colliders)
@@ -107,10 +99,10 @@ TEST(TressfxScenario, NoFreeVertexStartsInsideACollider) {
 }
 
 TEST(TressfxScenario, TestHair1AndMohawkCounts) {
-  const fs::path testhair = kShared / "assets/tressfx/testhair1/TestHair1.tfxproj";
-  const fs::path mohawk = kShared / "assets/tressfx/ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
-  SKIP_WITHOUT(testhair);
-  SKIP_WITHOUT(mohawk);
+  const fs::path testhair = kAssets / "testhair1/TestHair1.tfxproj";
+  const fs::path mohawk = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
+  ASSERT_PRESENT(testhair);
+  ASSERT_PRESENT(mohawk);
   expect_counts(load_scenario(builtin("tressfx_testhair1")), 10027, 4, 4);
   const Scenario m = load_scenario(builtin("tressfx_mohawk"));
   EXPECT_EQ(m.groom.strand_count(), 2226u);
@@ -133,7 +125,7 @@ TEST(TressfxScenario, TestHair1AndMohawkCounts) {
 }
 
 TEST(TressfxScenario, SimulateModeSimulatesEveryStrand) {
-  SKIP_WITHOUT(kPonytail);
+  ASSERT_PRESENT(kPonytail);
   const Scenario follow =
       load_scenario(write_scenario("follow", R"({ "tfx_project": ")" + kPonytail.string() + R"(" })"));
   const Scenario simulate = load_scenario(write_scenario(
@@ -146,48 +138,28 @@ TEST(TressfxScenario, SimulateModeSimulatesEveryStrand) {
 }
 
 TEST(TressfxScenario, InputErrorsNameTheKey) {
-  SKIP_WITHOUT(kPonytail);
+  ASSERT_PRESENT(kPonytail);
   const std::string project = R"("tfx_project": ")" + kPonytail.string() + R"(")";
   EXPECT_NE(error_of(write_scenario("unknown", "{ " + project + R"(, "units": "cm" })")).find("groom.units: unknown key"),
             std::string::npos);
   EXPECT_NE(error_of(write_scenario("mode", "{ " + project + R"(, "follow_hairs": "all" })")).find("groom.follow_hairs"),
             std::string::npos);
-  const std::string tfx = (kShared / "assets/tressfx/ponytail/tail.tfx").string();
+  const std::string tfx = (kAssets / "ponytail/tail.tfx").string();
   EXPECT_NE(error_of(write_scenario("pivot", R"({ "tfx": ")" + tfx + R"(" })")).find("groom.pivot: missing required key"),
             std::string::npos);
 }
 
-TEST(TressfxScenario, MissingAssetIsSkippedOnlyByBuiltinLoading) {
+TEST(TressfxScenario, MissingAssetIsAnErrorNamingTheFile) {
   const fs::path file = write_scenario("missing", R"({ "tfx_project": "no/such/hair.tfxproj" })");
-  try {
-    load_scenario(file);
-    FAIL() << "loaded without an error";
-  } catch (const MissingAssetError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind(file.string() + ": groom.tfx_project: no such file: ", 0), 0u) << msg;
-    EXPECT_NE(msg.find((file.parent_path() / "no/such/hair.tfxproj").string()), std::string::npos) << msg;
-  }
-
-  // Built-in loading leaves the scenario out with that message and keeps the others.
-  const fs::path dir = file.parent_path();
-  const char* before = std::getenv("HAIRBENCH_SCENARIO_DIR");
-  const std::string saved = before ? before : "";
-  fs::copy_file(builtin("idle"), dir / "idle.json", fs::copy_options::overwrite_existing);
-  setenv("HAIRBENCH_SCENARIO_DIR", dir.c_str(), 1);
-  std::vector<std::string> skipped;
-  const std::vector<Scenario> loaded = load_builtin_scenarios(&skipped);
-  if (before) setenv("HAIRBENCH_SCENARIO_DIR", saved.c_str(), 1);
-  else unsetenv("HAIRBENCH_SCENARIO_DIR");
-  ASSERT_EQ(loaded.size(), 1u);
-  EXPECT_EQ(loaded[0].name, "idle");
-  ASSERT_EQ(skipped.size(), 1u);
-  EXPECT_NE(skipped[0].find("groom.tfx_project: no such file"), std::string::npos) << skipped[0];
+  const std::string msg = error_of(file);
+  EXPECT_EQ(msg.rfind(file.string() + ": groom.tfx_project: no such file: ", 0), 0u) << msg;
+  EXPECT_NE(msg.find((file.parent_path() / "no/such/hair.tfxproj").string()), std::string::npos) << msg;
 }
 
 // Follow strands are rebuilt from their guides every frame: each follow root stays where
 // it was relative to its guide root (both are pinned to the head), while the head turns.
 TEST(TressfxScenario, FollowHairsMoveWithTheirGuides) {
-  SKIP_WITHOUT(kPonytail);
+  ASSERT_PRESENT(kPonytail);
   Scenario sc = load_scenario(builtin("tressfx_ponytail_shake"));
   ASSERT_TRUE(sc.follow.has_value());
   const ModelInfo* info = find_model("han_m3");
@@ -228,33 +200,22 @@ TEST(TressfxScenario, FollowHairsMoveWithTheirGuides) {
 }
 
 
-// A user's clone without ../shared: the built-in set still loads, and each TressFX scenario
-// is skipped with a message naming its missing asset file. (The scenario files are copied
-// to a folder from which their relative asset paths lead nowhere.)
-TEST(TressfxScenario, BuiltinSetSkipsEachMissingAsset) {
-  const fs::path dir = fs::temp_directory_path() / "hairbench_clone" / "a" / "b" / "builtin";
-  fs::remove_all(dir.parent_path().parent_path());
+// The built-in set ships its assets: every TressFX scenario is among the loaded ones, and
+// a built-in scenario copied away from its assets is an error naming its missing file (never
+// a silent skip that would shrink the default comparison).
+TEST(TressfxScenario, BuiltinSetLoadsEveryAssetAndRefusesAMissingOne) {
+  std::vector<std::string> names;
+  for (const Scenario& sc : load_builtin_scenarios()) names.push_back(sc.name);
+  for (const std::string& name : kTressfxScenarios)
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+
+  const fs::path dir = fs::temp_directory_path() / "hairbench_moved" / "builtin";
+  fs::remove_all(dir.parent_path());
   fs::create_directories(dir);
-  std::size_t copied = 0;
-  for (const fs::path& f : builtin_scenarios()) {
-    fs::copy_file(f, dir / f.filename());
-    ++copied;
-  }
-  const char* before = std::getenv("HAIRBENCH_SCENARIO_DIR");
-  const std::string saved = before ? before : "";
-  setenv("HAIRBENCH_SCENARIO_DIR", dir.c_str(), 1);
-  std::vector<std::string> skipped;
-  const std::vector<Scenario> loaded = load_builtin_scenarios(&skipped);
-  if (before) setenv("HAIRBENCH_SCENARIO_DIR", saved.c_str(), 1);
-  else unsetenv("HAIRBENCH_SCENARIO_DIR");
-  ASSERT_EQ(skipped.size(), kTressfxScenarios.size());
-  EXPECT_EQ(loaded.size() + skipped.size(), copied);
-  for (std::size_t k = 0; k < skipped.size(); ++k) {
-    EXPECT_NE(skipped[k].find((dir / (kTressfxScenarios[k] + ".json")).string()), std::string::npos) << skipped[k];
-    EXPECT_NE(skipped[k].find("no such file: "), std::string::npos) << skipped[k];
-    EXPECT_NE(skipped[k].find("shared/assets/tressfx/"), std::string::npos) << skipped[k];
-  }
-  for (const Scenario& sc : loaded) EXPECT_EQ(sc.name.rfind("tressfx_", 0), std::string::npos) << sc.name;
+  fs::copy_file(builtin("tressfx_mohawk"), dir / "tressfx_mohawk.json");
+  const std::string msg = error_of(dir / "tressfx_mohawk.json");
+  EXPECT_EQ(msg.rfind((dir / "tressfx_mohawk.json").string() + ": groom.tfx: no such file: ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("assets/tressfx/ratboy_mohawk_v4.0/Ratboy_mohawk.tfx"), std::string::npos) << msg;
 }
 
 // "The ponytail project runs with han_m1..han_m3 and stays stable", in both follow-hair
@@ -264,7 +225,7 @@ TEST(TressfxScenario, BuiltinSetSkipsEachMissingAsset) {
 // the head motion and solver settings are tressfx_ponytail_shake's. 130 frames cover the
 // shake (2 s) and its stop.
 TEST(TressfxScenario, PonytailProjectStaysStableWithHanModels) {
-  SKIP_WITHOUT(kPonytail);
+  ASSERT_PRESENT(kPonytail);
   const fs::path dir = fs::temp_directory_path() / "hairbench_thin_ponytail";
   fs::remove_all(dir);
   fs::create_directories(dir);

@@ -222,7 +222,7 @@ const bool registered = [] {
         ->Iterations(1)
         ->Unit(benchmark::kMillisecond);
   static std::vector<std::unique_ptr<Scenario>> scenarios;
-  std::vector<Scenario> all = load_builtin_scenarios(nullptr);
+  std::vector<Scenario> all = load_builtin_scenarios();
   for (Scenario& sc : paper_scenarios()) all.push_back(std::move(sc));
   for (const Scenario& sc : all) {
     for (std::size_t keep : kThinning) {

@@ -1,6 +1,6 @@
 // AMD TressFX hair assets: .tfx strand files (binary, 3.x and 4.x), .tfxsim simulation
 // settings and .tfxproj projects (text), and TressFX-style follow hairs. The layouts are
-// the ones of ../shared/assets/tressfx/README.md; everything here is pure except the
+// the ones of scenarios/assets/tressfx/README.md; everything here is pure except the
 // read_*/write_*/load_* functions, which only add file access.
 //
 // Every malformed input is one InputError whose message names the file and the place:

@@ -1,4 +1,4 @@
-// .tfx reader and writer, from the byte layouts of ../shared/assets/tressfx/README.md.
+// .tfx reader and writer, from the byte layouts of scenarios/assets/tressfx/README.md.
 #include "scenarios/tfx/tfx.h"
 
 #include "core/error.h"

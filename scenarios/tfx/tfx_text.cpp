@@ -1,5 +1,5 @@
 // .tfxsim and .tfxproj readers. Both formats are one "key value..." per line with '#'
-// comments (../shared/assets/tressfx/README.md and the shipped files); the sample files
+// comments (scenarios/assets/tressfx/README.md and the shipped files); the sample files
 // have trailing blanks and no final newline, so tokens are split on any whitespace and
 // a '\r' of Windows line ends is whitespace too.
 #include "scenarios/tfx/tfx.h"

@@ -2,7 +2,7 @@
 """Writes the tiny TressFX project in mini/ (test data for tfx_test and fuzz seeds).
 
 The .tfx files are written with Python's struct module straight from the layouts in
-../shared/assets/tressfx/README.md, independently of the C++ reader they test.
+scenarios/assets/tressfx/README.md, independently of the C++ reader they test.
 Run from this folder: python3 make_mini.py
 """
 import math
