@@ -20,8 +20,8 @@ class ThreadPool;
 // it is filled inside the timed step.
 //
 // A stage the scene does not need is not run and is reported through skip(), so the
-// report shows it as 0 ms and skipped rather than leaving it out (issue 8). A stage that
-// ran in any substep of the step counts as run.
+// report shows it as 0 ms and skipped rather than leaving it out. A stage that ran in
+// any substep of the step counts as run.
 class StageTimes {
  public:
   static constexpr std::size_t kMaxStages = 12;
@@ -80,11 +80,11 @@ struct ModelContext {
   std::string device;  // GPU models: --device NAME|INDEX, empty for the default device
   // false runs every stage and term even where it is inert (no colliders, zero wind,
   // zero stiffness) and never lets a strand sleep: the reference that shows skipping
-  // does not change the physics (issue 8), and the "off" side of the skip benchmarks.
+  // does not change the physics, and the "off" side of the skip benchmarks.
   bool skip_inert = true;
 };
 
-// Which per-frame stages and terms a step needs (issue 8), decided once per step from
+// Which per-frame stages and terms a step needs, decided once per step from
 // its input rather than by multiplying by zero inside the kernels: no colliders -> no
 // collision pass; zero wind -> no wind term.
 struct FramePlan {

@@ -14,17 +14,15 @@ std::pair<std::size_t, std::size_t> block(std::size_t n, int parts, int i) {
 
 // How long a worker waits for the next loop, and the caller for the workers, spinning
 // before it sleeps on a condition variable. A sleeping thread is woken through the
-// kernel, which takes tens of microseconds on the 2-vCPU machines (issue 10), and
-// plante_wisp runs one or two loops per 1 ms integration step: with the spin,
-// plante_wisp_ref on `shake` at 2 threads took 32.8-33.5 ms a frame instead of
-// 34.5-36.7 (hairbench_bench, 3 runs each). The other models run a loop per frame or
-// stage; a spin that ends unanswered costs them this much of the worker's time.
+// kernel, which takes tens of microseconds on small virtual machines, and plante_wisp
+// runs one or two loops per 1 ms integration step: a wake-up per loop would be a visible
+// share of its step. The other models run a loop per frame or stage; a spin that ends
+// unanswered costs them this much of the worker's time.
 constexpr auto kSpin = std::chrono::microseconds(100);
 
 // Spins until done() or kSpin has passed; whether done() held. Each turn yields the
 // core: where more threads run than there are cores (tests in parallel), a thread that
-// spins without yielding holds a core the others need (the test suite on 2 cores took
-// 90 s instead of 50).
+// spins without yielding holds a core the others need.
 template <class F>
 bool spin_until(F&& done) {
   const auto until = std::chrono::steady_clock::now() + kSpin;

@@ -1,4 +1,4 @@
-// Sleeping strands (issue 8): with the head still and no wind, a strand whose vertices
+// Sleeping strands: with the head still and no wind, a strand whose vertices
 // all stayed below a speed threshold for kQuietFrames consecutive frames is no longer
 // simulated until the head moves or wind starts. A sleeping strand's state is not
 // touched at all, so on waking it resumes bit-exactly from where the model left it.

@@ -20,9 +20,9 @@ double stream_seconds(std::size_t bytes, ThreadPool& pool) {
   std::vector<float> buf(std::max<std::size_t>(bytes / sizeof(float), 1), 1.0f);
   float* p = buf.data();
   // The best pass after two warm-up passes, over at least 20 passes and 10 ms: the best
-  // of a fixed ten passes (a millisecond on a model-1 state) caught whatever the machine
-  // did in that millisecond, and the same step time read as roofline 3.4 in one run and
-  // 9.2 in the next (issue 10).
+  // of a fixed few passes (a millisecond on a model-1 state) would catch whatever the
+  // machine did in that millisecond, and the same step time would read as very different
+  // roofline ratios from one run to the next.
   constexpr int kWarmUp = 2, kMinPasses = 20, kMaxPasses = 2000;
   constexpr double kMinSeconds = 0.010;
   double best = 1e30, measured = 0.0;

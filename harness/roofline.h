@@ -1,4 +1,4 @@
-// The memory floor of a step (issue 10): the time to stream a model's per-frame state
+// The memory floor of a step: the time to stream a model's per-frame state
 // once, read and write, on all threads of the pool. A model's step time over this is its
 // roofline_ratio (report timing.roofline_ratio, hairbench_bench's BM_step counter).
 #pragma once

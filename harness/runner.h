@@ -53,7 +53,7 @@ struct RunOptions {
   // the reference's snapshots.
   ScenarioRecord* scenario_record = nullptr;
   std::string device;  // GPU models' --device (empty: the default device)
-  // Stress runs (issue 8): a model whose mechanical energy keeps growing while the head
+  // Stress runs: a model whose mechanical energy keeps growing while the head
   // is still and no wind blows also fails (metrics::EnergyGrowthCheck).
   bool energy_check = false;
   // false (--no-skip): models run every stage even where it is inert and no strand

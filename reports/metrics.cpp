@@ -13,7 +13,7 @@ namespace {
 Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
 
 // The per-frame metrics cost about as much as a fast model's step in `compare`, which
-// computes them per model and frame (issue 10). Their hot loops are built twice, for
+// computes them per model and frame. Their hot loops are built twice, for
 // x86-64-v4 (AVX-512) and the baseline, and chosen at load time; the IEEE operations
 // give the same bits in either (no FMA contraction, -ffp-contract=off).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
@@ -122,7 +122,7 @@ Eigen::Vector3d curvature_binormal(const Eigen::Vector3d& e0, double l0, const E
 }  // namespace
 
 // Each edge and its length are computed once and handed on to the next vertex: the
-// metrics cost about as much as the models' steps in `compare` (issue 10).
+// metrics cost about as much as the models' steps in `compare`.
 double strand_jaggedness_raw(std::span<const Vec4f> s) {
   const std::size_t n = s.size();
   if (n < 4) return 0.0;
@@ -148,9 +148,9 @@ namespace {
 // lane: every lane repeats that function's operations in Eigen's order for 3-vectors
 // (sums left to right, cross product by components), so each strand gets the same bits.
 // The lanes are one GCC vector (LaneVec), whose operations are those IEEE operations lane
-// by lane: written as loops over arrays, GCC kept the running sums and the previous
-// binormal in scalar registers and added them one lane at a time (issue 10: the metrics
-// cost about as much as a fast model's step in `compare`).
+// by lane: written as loops over arrays, GCC keeps the running sums and the previous
+// binormal in scalar registers and adds them one lane at a time (and the metrics cost
+// about as much as a fast model's step in `compare`).
 using LaneVec = double __attribute__((vector_size(kLanes * sizeof(double))));
 
 // Lane by lane square root (a vector square root instruction where the target has one).
@@ -230,7 +230,7 @@ METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const std::size_t* 
 
 // Strands are grouped by size at load (group_for_lanes): a ragged groom such as Table 1's
 // model 1 rarely has kLanes consecutive strands of one size, and the strands left alone
-// took a fifth of `compare --models han_m3` on it (issue 10). Each strand's value is the
+// would take a large share of `compare --models han_m3` on it. Each strand's value is the
 // same either way, and they are added in index order: the same bits.
 METRIC_CLONES double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;
@@ -370,8 +370,8 @@ METRIC_CLONES std::string blowup_reason(const RestInfo& rest, std::span<const Ve
   // over the whole groom at once (edge_chunked); only if it flags a vertex or edge do the
   // strands take it one by one, and only a strand it flags takes the exact tests, in
   // order, so the first failure reported is the same. The square roots and branches per
-  // vertex were most of this function's cost, which `compare` pays per model and frame
-  // (issue 10).
+  // vertex would be most of this function's cost, which `compare` pays per model and
+  // frame.
   constexpr double kNear = 0.98, kShort = 0.26, kLong = 2.2;
   const double near2 = kNear * far * far;
   const Vec4f centre(head_center.x(), head_center.y(), head_center.z(), 0.0f);

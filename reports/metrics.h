@@ -60,10 +60,10 @@ std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const 
 
 // Mean specific mechanical energy per vertex, in J/kg: kinetic ½|v|² with the frame's
 // velocity v = (p - prev) / dt, plus gravitational -g·p. The stress test's growth check
-// (issue 8) watches it while nothing drives the hair.
+// watches it while nothing drives the hair.
 double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt, const Vec3f& gravity);
 
-// Issue 8's "energy growing for N frames with the head still": the frames are grouped in
+// "Energy growing for N frames with the head still": the frames are grouped in
 // windows of kWindow; a model fails when, with the head still and no wind for the whole
 // time, the window mean of mechanical_energy rose by more than kRise * g * L-bar (every
 // vertex lifted by 5% of a strand length) over each of kWindows consecutive windows, i.e.

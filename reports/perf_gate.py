@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Performance and accuracy gate: candidate against baseline (issue 9).
+"""Performance and accuracy gate: candidate against baseline.
 
 Speed: per benchmark, the samples are the repetitions of Google Benchmark's own JSON
 (run_type "iteration"; real_time, which is the manual time of hairbench_bench). A

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Heatmap of a `hairbench stress` report (issue 8): one row per model x axis, one cell
+"""Heatmap of a `hairbench stress` report: one row per model x axis, one cell
 per value tried in escalation order, green where the model stayed stable and red where
 it failed; degenerate grooms as a second panel.
 

@@ -1,5 +1,5 @@
-// Side-by-side runs of a fast model and its per-stage reference (issue 10), shared by the
-// han_fused and halen_fused agreement tests.
+// Side-by-side runs of a fast model and its per-stage reference, shared by the han_fused
+// and halen_fused agreement tests.
 #pragma once
 
 #include "test_support.h"
@@ -67,7 +67,7 @@ inline std::uint64_t state_hash_after(const Scenario& sc, const std::string& mod
   return metrics::state_hash(m->positions());
 }
 
-// Sleeping strands (issue 8) and their wake-up: `idle` (every 16th strand) for 200
+// Sleeping strands and their wake-up: `idle` (every 16th strand) for 200
 // frames, the head still until it turns at 2 s.
 inline Scenario idle_then_turn() {
   Scenario sc = builtin("idle", 16);

@@ -59,7 +59,7 @@ TEST(HalenFused, BitIdenticalToReferenceOnRaggedPaperGroom) {
   for (const std::string& m : kExact) EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, {}), -1) << m;
 }
 
-// Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
+// Sleeping strands: the same strands fall asleep at the same frame, hold still
 // and wake when the head turns, in both implementations.
 TEST(HalenFused, BitIdenticalToReferenceThroughSleepAndWake) {
   const Scenario sc = test::idle_then_turn();

@@ -136,8 +136,8 @@ TEST(HalenForest, GimbalStiffnessAndTheXAxisFix) {
 double oscillation_energy(const Scenario& sc, const std::string& model, double down_fraction, double from) {
   const ModelInfo* info = find_model(model);
   ThreadPool pool(2);
-  // The instability grows from rounding noise at rest, which sleeping strands (issue 8,
-  // below 0.1 mm/s) would freeze: this measures the model's own dynamics.
+  // The instability grows from rounding noise at rest, which sleeping strands (below
+  // 0.1 mm/s) would freeze: this measures the model's own dynamics.
   ModelContext ctx{&pool};
   ctx.skip_inert = false;
   auto m = info->make(ctx);
@@ -176,10 +176,10 @@ double oscillation_energy(const Scenario& sc, const std::string& model, double d
 // reference nodes to a fraction". Long (40 cm) strands under gravity, head still: with
 // equal up/down stiffness the rest pose is unstable and rounding alone sets the hair
 // moving; with downward springs at a quarter it stays nearly still.
-// Known difference: the issue's version of this test, the energy left after the head
-// stops moving (2 s of `nod`, then 1 s still), does not show it: equal stiffness leaves
-// 0.013 m²/s² per vertex, a quarter 0.022. More springs make the strand stiffer, which
-// damps the swing after a motion faster than the struggle excites it on that time scale.
+// Known difference: the energy left after the head stops moving (2 s of `nod`, then 1 s
+// still) does not show it: equal stiffness leaves 0.013 m²/s² per vertex, a quarter
+// 0.022. More springs make the strand stiffer, which damps the swing after a motion
+// faster than the struggle excites it on that time scale.
 TEST(HalenCascade, EqualDownwardStiffnessIsUnstableAtRest) {
   Scenario sc = builtin("idle", 16);
   GroomSpec spec;

@@ -76,7 +76,7 @@ TEST(HanFused, BitIdenticalWithStagesOff) {
       EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, ov), -1) << m << " " << ov[0].name;
 }
 
-// Sleeping strands (issue 8): the same strands fall asleep at the same frame, hold still
+// Sleeping strands: the same strands fall asleep at the same frame, hold still
 // and wake when the head turns, in both implementations.
 TEST(HanFused, BitIdenticalToReferenceThroughSleepAndWake) {
   const Scenario sc = test::idle_then_turn();

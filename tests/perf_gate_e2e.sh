@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end check of ci/perf-gate (issue 9): the unchanged build against itself passes
+# End-to-end check of ci/perf-gate: the unchanged build against itself passes
 # (exit 0), and the same build with the test-only knob HAIRBENCH_BENCH_PLANTED_SLOWDOWN=0.3
 # (30% more work in every timed step, harness/bench/step_bench.cpp) is caught (exit 1).
 #
@@ -9,7 +9,7 @@
 # on idle at 500 strands: method 1 is the scenario's reference, so no second model steps
 # alongside) instead of timing it. The planted work is a fixed number of extra steps, so
 # both counts are the same on every run, whatever else loads the machine: a timed gate
-# on a 2-core machine shared with other jobs saw +12% between two identical builds.
+# on a 2-core machine shared with other jobs can see +12% between two identical builds.
 set -uo pipefail
 bin=${1:?usage: perf_gate_e2e.sh BUILD_DIR}
 root=$(cd "$(dirname "$0")/.." && pwd)

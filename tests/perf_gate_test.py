@@ -1,5 +1,5 @@
 """Unit tests of reports/perf_gate.py: the statistics against known values and the
-decisions of the speed, instruction and accuracy gates (issue 9)."""
+decisions of the speed, instruction and accuracy gates."""
 
 import json
 import os

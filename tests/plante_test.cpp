@@ -217,9 +217,9 @@ TEST(PlanteWisp, RebuildIsDeterministic) {
 // direction by a bending spring, as the first free one is by the pinned root segment
 // (§3.2). A curl of 15 segments of 6.6 mm bent into a half circle, pinned at both ends,
 // under gravity on a head shaking +-30 degrees at 1 Hz about the curl's own axis
-// (tressfx_ponytail_shake's motion): without that spring the last segment swung about
-// the pinned tip by 85 degrees here (on the ponytail, the rebuilt strands stretched past
-// 50% at frame 4); with it, it stays within 30 degrees.
+// (tressfx_ponytail_shake's motion): without that spring the last segment would swing
+// about the pinned tip by 85 degrees here (on the ponytail, the rebuilt strands would
+// stretch past 50% at frame 4); with it, it stays within 30 degrees.
 // `count` such curls, 1 cm apart along z.
 Groom tip_pinned_curls(int count) {
   Groom g;
@@ -274,7 +274,7 @@ TEST(PlanteWisp, TipPinnedWispKeepsItsLastSegmentDirection) {
   EXPECT_LT(widest * 180.0 / std::numbers::pi, 30.0);
 }
 
-// Wisps pinned at the tip go through the block kernels too (issue 10: 488 of
+// Wisps pinned at the tip go through the block kernels too (488 of
 // tressfx_ponytail_shake's wisps), the tip's spring on their lanes: 16 such curls, one
 // wisp each, agree bit for bit with the per-wisp kernels of plante_wisp_ref.
 TEST(PlanteWisp, TipPinnedWispsInABlockAgreeWithTheReference) {
@@ -335,7 +335,7 @@ TEST(PlanteWisp, NoNaNOnEveryBuiltinScenario) {
 }
 
 // §3.4/§5.2: the rebuilt strands - the model's positions - keep their edges within the
-// harness's 50% bound through the scenarios where they used to break it (issue 5), for
+// harness's 50% bound through the scenarios that strain them most, for
 // the whole run and with every 4th strand (wisps of the thinned groom are sparser, so
 // wider, than the full groom's). Where the error comes from, and its bound: the skeleton
 // springs stretch a segment by < 10% (axial stiffness, bending springs stiff enough to
@@ -344,9 +344,9 @@ TEST(PlanteWisp, NoNaNOnEveryBuiltinScenario) {
 // point axially by about 0.5 tan(phi/2) edges; the envelope's scale lies in [0.25, 2];
 // the first free edge is anchored to the strand's own root (rebuild). Measured (max
 // edge error / worst-frame RMS): ponytail 0.19 / 0.026, spin_fast 0.23 / 0.062,
-// tilt_upside_down 0.20 / 0.020, wind_gust 0.06 / 0.019 (before the fix: 0.5-1.4 max,
-// unstable). The bounds, 0.35 and 0.09, are 1.5 times the largest measured values:
-// well inside the harness's 50%, and tight enough to catch the old failure.
+// tilt_upside_down 0.20 / 0.020, wind_gust 0.06 / 0.019 (without the root anchor:
+// 0.5-1.4 max, unstable). The bounds, 0.35 and 0.09, are 1.5 times the largest measured
+// values: well inside the harness's 50%, and tight enough to catch an unanchored rebuild.
 TEST(PlanteWisp, RebuiltStrandsKeepTheirEdgeLengths) {
   for (const char* name : {"ponytail", "spin_fast", "tilt_upside_down", "wind_gust"}) {
     const Scenario sc = builtin(name, 4);
@@ -380,7 +380,7 @@ TEST(PlanteWisp, DeterministicAcrossRunsAndThreads) {
   EXPECT_EQ(a[0].state_hash, c[0].state_hash);
 }
 
-// Issue 10: plante_wisp (one fused pass per wisp and step) performs the per-stage
+// plante_wisp (one fused pass per wisp and step) performs the per-stage
 // schedule's (plante_wisp_ref's) floating-point operations in the same order,
 // so the two agree bit for bit, frame by frame, through the whole shake and its stop
 // (head turning, body contacts, wisp-wisp contacts, sleeping at the end), on 1 and 2
@@ -401,7 +401,7 @@ TEST(PlanteWisp, FastAgreesBitForBitWithTheReference) {
   EXPECT_EQ(one[0].state_hash, slow.state_hash);
 }
 
-// Issue 10: plante_wisp's block kernels of the wisp-body passes (detection, sliding
+// plante_wisp's block kernels of the wisp-body passes (detection, sliding
 // contacts and holds over the listed contacts) and of the rebuild agree with
 // plante_wisp_ref's per-wisp kernels bit for bit, frame by frame, also where masses start
 // inside a body: with the head sphere grown by 5 mm, the first free nodes of many wisps
@@ -432,7 +432,7 @@ TEST(PlanteWisp, BodyBlockKernelsAgreeWhereMassesStartInside) {
   EXPECT_GT(listed, 0u) << "no body contact listed: the sliding and holding lanes were not reached";
 }
 
-// Issue 10: the broad phase's grid built in parts (grid_frame, grid_count, grid_offsets,
+// The broad phase's grid built in parts (grid_frame, grid_count, grid_offsets,
 // grid_fill: what plante_wisp runs on its threads) is the grid grid_cells builds, entry
 // for entry, for any number of parts, on a shaken state with segments in every cell.
 TEST(PlanteWisp, GridInPartsIsTheSerialGrid) {

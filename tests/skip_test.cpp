@@ -1,4 +1,4 @@
-// Issue 8, "skip what a scene does not need": a stage the scene makes inert is not run,
+// Skip what a scene does not need: a stage the scene makes inert is not run,
 // and not running it never changes the physics; settled strands sleep and wake
 // bit-exactly; a scenario may give each region its own Han method (§6).
 #include "test_support.h"

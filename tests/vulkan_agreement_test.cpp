@@ -1,4 +1,4 @@
-// The Vulkan models against the CPU models on the scenarios and on every
+// The Vulkan models against the CPU models on the agreement scenarios and on every
 // shipped scenario (slow on lavapipe: label slow). Method 3 on shake is in vulkan_test.
 #include "vulkan_support.h"
 

@@ -32,7 +32,7 @@ struct Agreement {
 
 // Runs `cpu` and `vk` (registry names) on the scenario for `frames` frames with the same
 // resolved parameters and compares positions vertex by vertex after every frame (the
-// issue asks for the last frame; every frame is the stronger check).
+// bound is stated for the last frame; every frame is the stronger check).
 // `groom_b`, when given, replaces the scenario's groom for the second model.
 inline Agreement agreement(const Scenario& sc, const std::string& cpu, const std::string& vk, int frames,
                            const std::vector<ParamOverride>& overrides = {}, const Groom* groom_b = nullptr) {

@@ -28,7 +28,7 @@ TEST(VulkanRuntime, ListsDevices) {
   for (const auto& d : devices) EXPECT_FALSE(d.name.empty());
 }
 
-// The agreement bound: after 120 frames every vertex within 1e-4 of L-bar of
+// The agreement bound: after 120 frames every vertex within 1e-4 of L-bar of
 // the CPU model's (float reordering only, no algorithmic difference).
 TEST(VulkanAgreement, Method3Shake) {
   HAIRBENCH_REQUIRE_VULKAN();

@@ -1,7 +1,7 @@
 // BM_metric/METRIC/SCENARIO: one per-frame metric of reports/metrics.h on one frame's
 // positions, on one thread (as `compare` runs it: one task per model and metric). In
 // `compare` the metrics run every frame for every model, and cost about as much as the
-// fast models' steps (issue 10).
+// fast models' steps.
 //
 // The positions are han_m3's after a quarter of the scenario's frames: a moving, bent
 // groom, the same every run. Scenarios: `shake` (built in) and Table 1's model 1 groom

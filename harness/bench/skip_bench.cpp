@@ -1,4 +1,4 @@
-// Issue 8, what skipping saves, per CPU model (filter: --benchmark_filter=BM_skip):
+// What skipping inert stages saves, per CPU model (filter: --benchmark_filter=BM_skip):
 //
 //   BM_skip/MODEL/FEATURE:on|off  `shake` with the feature present (on) and absent (off):
 //       colliders (the head sphere / none), wind (a steady 6 m/s^2 wind / none),
@@ -6,7 +6,7 @@
 //       step in that stage; the skipped stage reads 0 in the off run, and the step time
 //       drops by about the on run's stage time.
 //   BM_settled/MODEL/idle|shake  step time once `idle` has settled (its strands asleep),
-//       against `shake` while it shakes: issue 8 asks idle < 10% of shake.
+//       against `shake` while it shakes: settled, idle should cost < 10% of shake.
 //
 // One iteration is one frame; manual time covers step() only.
 #include "core/parallel.h"

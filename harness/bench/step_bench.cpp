@@ -17,7 +17,7 @@
 //
 // Besides the built-in scenarios, the paper's grooms (scenarios/paper, e.g.
 // han2012_model1: Table 1 model 1, 19,776 strands) are registered too.
-// BM_step_1thread/... is the same benchmark on one thread (thread scaling, issue 10).
+// BM_step_1thread/... is the same benchmark on one thread (thread scaling).
 //
 // The roofline probes: BM_roofline_stream/bytes:N streams a buffer (read + write) on all
 // threads, in GB/s; BM_roofline_fma runs independent fused multiply-add chains on all
@@ -26,7 +26,7 @@
 // Test-only knob: HAIRBENCH_BENCH_PLANTED_SLOWDOWN=F (e.g. 0.3) steps a second instance of
 // the model, inside the timed region, on a fraction F of the frames: F times the step's
 // work, real and deterministic (the same instruction count every run), so that
-// tests/perf_gate_e2e.sh can check that ci/perf-gate catches a known slowdown (issue 9).
+// tests/perf_gate_e2e.sh can check that ci/perf-gate catches a known slowdown.
 // Unset or 0: no extra work.
 #include "core/parallel.h"
 #include "harness/roofline.h"

@@ -32,8 +32,8 @@ const Scenario& scenario(int index) {
 // reports the device time of each step. The first frame (pipeline compilation on some
 // drivers) is stepped before timing starts. Counters: wall_ms, the mean wall time of
 // step() (upload, submit, wait); readback_ms, the mean time of positions() after it (the
-// copy back that compare and the follow hairs pay every frame; on a discrete GPU it once
-// took 50 ms a frame, unseen by the device time).
+// copy back that compare and the follow hairs pay every frame, and which the device time
+// does not see).
 void BM_HanVk(benchmark::State& state) {
   const std::string why = han_vk::unavailable(ModelContext{});
   if (!why.empty()) {

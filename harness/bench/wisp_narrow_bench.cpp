@@ -1,6 +1,6 @@
 // BM_wisp_grid and BM_wisp_narrow_phase/{ref,fast}: the parts of plante_wisp's wisp-wisp
 // detection (Plante et al. 2001 §4.1) on one frozen state, one thread, so that a change
-// to one of them is measured without the rest of the step and its noise (issue 10).
+// to one of them is measured without the rest of the step and its noise.
 // The state: plante_wisp stepped through the first kFrames frames of `shake` (the head
 // turning, the hair spread and in contact). BM_wisp_grid rebuilds the broad phase's
 // grid (grid_build); BM_wisp_narrow_phase tests every pair of it, `ref` by

@@ -250,8 +250,8 @@ inline bool any_lane(const int* flags) {
 // when a pass left the row as it was, bit for bit (lanes projected onto a sphere that
 // round to points still inside it repeat the same projection; han_soa_kernel.cpp).
 // Vector pushes beat one scalar push per lane inside: the cascade's strands rest on the
-// spheres with several lanes of a row inside (measured 8% of its frame on model 1, the
-// spring model even).
+// spheres with several lanes of a row inside (on model 1; the spring model does no
+// worse).
 // The test accumulates into every lane with bitwise operations (no branch, no reduction
 // per sphere), so it stays one vector loop per sphere.
 void collide(const Rows& r, const Substep& s) {

@@ -5,8 +5,8 @@
 // groom-ordered float4 array (the HairModel interface) into rows, then every substep's
 // integration, global shape, local shape / edge length iterations and collisions run,
 // then one write puts the positions back. The positions live only in that array, not in
-// the block as well (issue 10): method 3's state on the Table 1 model-1 groom is 9.3 MiB
-// instead of 12.7, at the cost of a transpose per row per frame.
+// the block as well: method 3's state on the Table 1 model-1 groom is 9.3 MiB rather
+// than 12.7, at the cost of a transpose per row per frame.
 //
 // Every lane performs the same floating-point operations in the same order as the
 // per-strand kernels of strand_kernels.cpp (with Eigen's evaluation order written out:

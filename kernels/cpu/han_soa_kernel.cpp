@@ -96,9 +96,8 @@ inline void child_frame(const Quat& parent, const float* ax, const float* ay, co
   // array becomes a masked store, and the next edge's loads of the frame cannot take
   // their values from a masked store still in the store queue (they wait for it).
 #if defined(__AVX512F__)
-  // GCC still wrote the loop below with a masked store before each whole one (out may
-  // be parent); as intrinsics, every store is whole (issue 10; model 1 groom, one
-  // thread: method 1 5.71-5.73 -> 5.44-5.63 ms, method 2 9.47-9.49 -> 8.84-8.85 ms).
+  // Intrinsics, so that every store is whole: GCC writes the loop below with a masked
+  // store before each whole one (out may be parent).
   const __m512 zero = _mm512_setzero_ps();
   const __m512 mx = _mm512_loadu_ps(m.x), my = _mm512_loadu_ps(m.y);
   const __m512 mz = _mm512_loadu_ps(m.z), mw = _mm512_loadu_ps(m.w);
@@ -152,10 +151,9 @@ inline void local_lane(float& ax, float& ay, float& az, float& bx, float& by, fl
 
 // The local shape constraint of edge (a, b) towards goal (Eq. 4, local_shape_edge).
 // ka, kb: the edge's mass weights (mass_weights). With AVX-512 the select of the lanes
-// that move is a masked operation on the full row, stored whole (issue 10): as GCC wrote
-// the loop, a masked store, which the next edge of method 1 (its goal from the frame
-// this edge moves) could not load from until it left the store queue. Method 1, model 1
-// groom, one thread: 6.99-7.18 -> 5.82-5.91 ms.
+// that move is a masked operation on the full row, stored whole: as GCC writes the loop,
+// it is a masked store, which the next edge of method 1 (its goal from the frame this
+// edge moves) cannot load from until it has left the store queue.
 inline void local_edge(float* __restrict ax, float* __restrict ay, float* __restrict az, const float* aw,
                        float* __restrict bx, float* __restrict by, float* __restrict bz, const float* bw,
                        const float* ka, const float* kb, const float* gx, const float* gy, const float* gz,
@@ -296,7 +294,7 @@ inline void integrate_row(const Rows& r, int i, const soa::AffinePose& h, const 
 // the per-strand kernel. With kGlobal, the global shape constraint (global_row) follows
 // one row behind, while the rows are still in L1 and registers: row i-1 once row i, the
 // last to read it, has been integrated. The same bits as the two stages one after the
-// other (issue 10).
+// other.
 template <bool kWindy, bool kGlobal>
 void integrate(const Rows& r, const RowKind* kinds, int n, const Substep& s, const Frame& f, const BlockParams& p) {
   const soa::AffinePose h(s.m, s.t);
@@ -378,7 +376,7 @@ inline void length_lane(float& ax, float& ay, float& az, float& bx, float& by, f
 // one iteration and the first of the next take the same pairs of vertices, and the pairs
 // of a batch are disjoint, so applying both constraints to a pair before moving to the
 // next gives every constraint the positions it had batch by batch: the same bits, with
-// the pair loaded and stored once instead of twice (issue 10).
+// the pair loaded and stored once instead of twice.
 enum class EdgeOp : std::uint8_t { kNone, kLocal, kLength };
 
 // The rows one edge reads and writes, as restrict pointers, so that the compiler need
@@ -625,8 +623,8 @@ inline unsigned inside_mask(const float* px, const float* py, const float* pz, c
 // so passes stop once one leaves the row as it was, bit for bit: every pass after it
 // would do the same. That is the case when no lane was inside, and also often when the
 // lanes projected onto a sphere round to points still inside it: the projection then
-// repeats itself (model 1 groom: 569,500 of the 1,025,003 passes of 296,321 rows in
-// contact over 120 frames; stopping at the first saves 35% of the passes, issue 10).
+// repeats itself (on a groom resting on its spheres, such as model 1's, a large share of
+// the passes over rows in contact).
 // Most rows have no lane inside any sphere: they are found by one test of every sphere
 // (a row outside every sphere is not moved by any pass).
 void collide(const Rows& r, const RowKind* kinds, int n, const Substep& s) {

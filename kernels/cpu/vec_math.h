@@ -32,15 +32,15 @@ inline void sincos_poly(float x, float& s, float& c) {
 }
 
 // atan2(y, x) for y > 0: the angle in (0, π) between two directions, from |a × b| and
-// a · b. libm's atan2f is a call, which kept the lane loops around it scalar (8% of
-// plante_wisp's time on shake, issue 10). Reduction: q = min(y, |x|) / max(y, |x|) in
-// [0, 1], and atan q = π/4 + atan((q - 1) / (q + 1)) above tan(π/8), so that the
-// polynomial's argument t has |t| <= tan(π/8); atan t = t + t^3 P(t^2), P of degree 4
-// with coefficients fitted to atan's relative error on that interval (0.66 ulp there in
-// float arithmetic as written). Then π/2 - a where y > |x|, and π - a where x < 0.
-// One division: (q - 1) / (q + 1) = (lo - hi) / (lo + hi). Its rounding just above
-// tan(π/8) is the worst case: within 3 ulp of atan2 on the upper half plane
-// (tests/plante_test.cpp). NaN in, NaN out.
+// a · b. libm's atan2f is a call, which keeps the lane loops around it scalar.
+// Reduction: q = min(y, |x|) / max(y, |x|) in [0, 1], and atan q = π/4 +
+// atan((q - 1) / (q + 1)) above tan(π/8), so that the polynomial's argument t has
+// |t| <= tan(π/8); atan t = t + t^3 P(t^2), P of degree 4 with coefficients fitted to
+// atan's relative error on that interval (0.66 ulp there in float arithmetic as
+// written). Then π/2 - a where y > |x|, and π - a where x < 0. One division:
+// (q - 1) / (q + 1) = (lo - hi) / (lo + hi). Its rounding just above tan(π/8) is the
+// worst case: within 3 ulp of atan2 on the upper half plane (tests/plante_test.cpp).
+// NaN in, NaN out.
 inline float atan2_upper(float y, float x) {
   constexpr float kTanPi8 = 0.414213562373095f;
   constexpr float kPi4 = 0.785398163397448f, kPi2 = 1.57079632679490f, kPi = 3.14159265358979f;

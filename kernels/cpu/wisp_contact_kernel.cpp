@@ -1,9 +1,9 @@
-// The impulses of the wisp-wisp contacts (wisp_soa.h, ImpulsesFn) for kLanes contacts
-// at once, one contact per lane (issue 10). Each lane performs the operations of
-// contact_impulse (wisp_kernels.cpp, §4.1) in their order (wisp_lanes.h), so it gets the
-// same bits; a lane whose plane normal falls back to an arbitrary orthogonal (wisps
-// parallel and the point on the segment's axis) is redone by contact_impulse. Compiled
-// once per ISA variant, like the block kernels (kernels/CMakeLists.txt).
+// The impulses of the wisp-wisp contacts (wisp_soa.h, ImpulsesFn) for kLanes contacts at
+// once, one contact per lane. Each lane performs the operations of contact_impulse
+// (wisp_kernels.cpp, §4.1) in their order (wisp_lanes.h), so it gets the same bits; a
+// lane whose plane normal falls back to an arbitrary orthogonal (wisps parallel and the
+// point on the segment's axis) is redone by contact_impulse. Compiled once per ISA
+// variant, like the block kernels (kernels/CMakeLists.txt).
 #include "kernels/cpu/wisp_lanes.h"
 #include "kernels/cpu/wisp_soa.h"
 

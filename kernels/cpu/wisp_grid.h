@@ -31,9 +31,9 @@ struct SegmentGrid {
   std::vector<std::uint32_t> wisp;                 // wisp of segment i
   std::vector<Vec3f> lo, hi;                       // bounding box of skeleton + envelope masses
   std::vector<Eigen::Vector3i> cell_lo, cell_hi;   // cells each box covers
-  // Per segment, set up once per detection for its tests against every other one
-  // (issue 10): its volume, the positions of the masses it owns, and whether they are
-  // free (node seg[i] + 1 is not pinned).
+  // Per segment, set up once per detection for its tests against every other one: its
+  // volume, the positions of the masses it owns, and whether they are free
+  // (node seg[i] + 1 is not pinned).
   std::vector<SegmentVolume> vol;
   std::vector<SegmentMasses> mass;
   std::vector<std::uint8_t> mass_free;
@@ -49,8 +49,8 @@ struct SegmentGrid {
   // first met in the lowest cell they share in z, y, x order: per axis the larger of
   // their cell_lo. So a segment i meets item j there first iff, on every axis where the
   // cell lies past i's cell_lo, j's box starts in it; the narrow phase tests this with
-  // the boxes, and needs no mailbox (issue 10: the mailbox's branch, about one duplicate
-  // per new pair on model 1, was the hottest of the candidate loop).
+  // the boxes, and needs no mailbox (a mailbox's branch, taken by about one duplicate
+  // per new pair on model 1, would be the hottest of the candidate loop).
   std::vector<std::uint8_t> item_first;
   // CSR: per segment, its own entry in each of its cells, in z, y, x order (the later
   // segments of a cell follow it there).
@@ -63,7 +63,7 @@ struct SegmentGrid {
   std::vector<std::uint32_t> part_items;
   // Per segment, its candidates: the later segments in its cells, summed over the cells.
   // The narrow phase of segment i costs about that much, and it falls the more the later
-  // i is, so equal ranges of segments are far from equal work (issue 10: grid_split).
+  // i is, so equal ranges of segments are far from equal work (see grid_split).
   std::vector<std::uint32_t> candidates;
 
   std::size_t size() const { return seg.size(); }
@@ -77,7 +77,7 @@ inline constexpr int kMaxGridCells = 64;
 
 // Rebuilds the grid from the current state: grid_segments, grid_setup of every segment,
 // then grid_cells. In parts, so that grid_setup can run over ranges of segments on
-// several threads (issue 10); any split gives the same grid.
+// several threads; any split gives the same grid.
 void grid_build(SegmentGrid& g, const WispSystem& s);
 // The segments that take part, and every per-segment array sized for them.
 void grid_segments(SegmentGrid& g, const WispSystem& s);
@@ -85,21 +85,21 @@ void grid_segments(SegmentGrid& g, const WispSystem& s);
 void grid_setup(SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end);
 // The cells, from the segments' boxes, and each segment's candidates.
 void grid_cells(SegmentGrid& g);
-// grid_cells in steps, so that its loops over the segments can run on several threads
-// (issue 10): grid_frame (the cells from the boxes' bounds, and `parts` equal ranges of
-// segments), grid_count of every part, grid_offsets, then grid_fill of every part. Any
-// number of parts gives the same grid.
+// grid_cells in steps, so that its loops over the segments can run on several threads:
+// grid_frame (the cells from the boxes' bounds, and `parts` equal ranges of segments),
+// grid_count of every part, grid_offsets, then grid_fill of every part. Any number of
+// parts gives the same grid.
 void grid_frame(SegmentGrid& g, std::size_t parts);
 void grid_count(SegmentGrid& g, std::size_t part);
 void grid_offsets(SegmentGrid& g);
 void grid_fill(SegmentGrid& g, std::size_t part);
 
-// The narrow phase as first written (plante_wisp_ref; issue 10 keeps it as the reference
-// of wisp_soa's ContactsFn, which finds the same contacts in the same order): for each
-// segment in [begin, end), every later segment of its cells, one pair at a time (box
-// test, then each of the five masses of either segment in the other's volume by
-// SegmentVolume::contains). `mailbox` holds one entry per segment, all != any index in
-// [begin, end) on entry; a pair is tested where it is first met.
+// The plain narrow phase (plante_wisp_ref's, and the reference of wisp_soa's ContactsFn,
+// which finds the same contacts in the same order): for each segment in [begin, end),
+// every later segment of its cells, one pair at a time (box test, then each of the five
+// masses of either segment in the other's volume by SegmentVolume::contains). `mailbox`
+// holds one entry per segment, all != any index in [begin, end) on entry; a pair is
+// tested where it is first met.
 void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                        std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
 

@@ -31,14 +31,14 @@ __m512 halves(const float* lo, const float* hi) {
 }
 #endif
 
-// Cheap bounds of the masses of segment i (node seg[i] + 1 and its envelope) against
-// the volume of segment j, 8 lanes for its 5 masses (issue 10): the axial one of the
-// full test (masses_in), widened by far more than rounding (these sums may round
-// otherwise, and the quotient by len2 is a product with its reciprocal), and the
-// distance to the axis within vol.reach2. Most masses are outside one of them, and
-// every mass the full test finds is inside both. Bit q for mass q; none where the
-// masses are pinned or the volume is degenerate (it holds nothing), all where it is so
-// thin that 1 / len2 overflows (the full test decides).
+// Cheap bounds of the masses of segment i (node seg[i] + 1 and its envelope) against the
+// volume of segment j, 8 lanes for its 5 masses: the axial one of the full test
+// (masses_in), widened by far more than rounding (these sums may round otherwise, and the
+// quotient by len2 is a product with its reciprocal), and the distance to the axis within
+// vol.reach2. Most masses are outside one of them, and every mass the full test finds is
+// inside both. Bit q for mass q; none where the masses are pinned or the volume is
+// degenerate (it holds nothing), all where it is so thin that 1 / len2 overflows (the
+// full test decides).
 std::uint32_t near_half(const SegmentVolume& vol, const SegmentMasses& m, bool free) {
   if (!free || !(vol.len2 > 0.0f)) return 0;
   if (!(vol.inv_len2 < INFINITY)) return (1u << kMassesPerSegment) - 1;
@@ -109,7 +109,7 @@ std::uint32_t masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i
   const SegmentMasses& m = g.mass[i];
   alignas(32) std::int32_t near[SegmentMasses::kWidth];
   // The full test (SegmentVolume), for all the masses at once: each lane performs the
-  // operations of the per-point test of plante_wisp before issue 10 in its order (Eigen's
+  // operations of the per-point test (SegmentVolume::contains) in its order (Eigen's
   // 3-vector dot products and norms sum x + (y + z); its quotients by a scalar are
   // divisions), so the same contacts are found with the same axial parameters.
   // The segment's values, as scalars read once: the lanes then run as vector code.
@@ -156,11 +156,11 @@ std::uint32_t masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i
 
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
 // Two full tests at once: the masses of i1 against the volume of j1 in lanes 0-7, those
-// of i2 against j2 in lanes 8-15 (issue 10: a test's chain of divisions and a square
-// root is long, and a vector of 16 costs what one of 8 does). Each lane performs
-// masses_in's operations in its order (unfused: -ffp-contract=off), so the same contacts
-// with the same axial parameters: the bits and axial parameters of the first test in
-// bits 0-7 and axial[0, 8), those of the second in bits 8-15 and axial[8, 16).
+// of i2 against j2 in lanes 8-15 (a test's chain of divisions and a square root is long,
+// and a vector of 16 costs what one of 8 does). Each lane performs masses_in's operations
+// in its order (unfused: -ffp-contract=off), so the same contacts with the same axial
+// parameters: the bits and axial parameters of the first test in bits 0-7 and
+// axial[0, 8), those of the second in bits 8-15 and axial[8, 16).
 std::uint32_t masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t i1, std::size_t j1, std::size_t i2,
                           std::size_t j2, float* axial) {
   const SegmentVolume &v1 = g.vol[j1], &v2 = g.vol[j2];
@@ -233,9 +233,9 @@ std::uint32_t masses_in_2(const SegmentGrid& g, const WispSystem& s, std::size_t
 // cell_lo[a], is set in their item_first: SegmentGrid::item_first) and whose segment is
 // `first_pair` or later. As bits from b on; e - b <= 32.
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
-// 16 items per vector, the last ones by masked loads (issue 10: the scalar remainder of
-// the 8-lane loop GCC made was a fifth of the box tests' time; a cell's later items
-// number 26 on average on shake).
+// 16 items per vector, the last ones by masked loads (a scalar remainder, as GCC makes
+// for an 8-lane loop, would be a large share of the box tests' time: a cell's later
+// items number 26 on average on shake).
 std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e, const Vec3f& lo, const Vec3f& hi,
                           std::uint8_t past, std::uint32_t first_pair) {
   const __m512 lx = _mm512_set1_ps(lo.x()), ly = _mm512_set1_ps(lo.y()), lz = _mm512_set1_ps(lo.z());
@@ -280,13 +280,13 @@ std::uint32_t overlapping(const SegmentGrid& g, std::uint32_t b, std::uint32_t e
 }
 #endif
 
-// The pairs the box tests leave, tested in batches, in order (issue 10). Their loads are
-// started as they are added: a pair's partner segment lies anywhere in memory. Then, per
-// batch: near_pair of every pair (independent, so their chains of vector operations
-// overlap; tested one at a time, each waited on the last one's branches), the full tests
-// they leave as a list (written without a branch: about a third of the directions go
-// either way), and those tests two at a time (masses_in_2). The contacts come out as
-// testing each pair in turn appends them: masses of i in j, then of j in i.
+// The pairs the box tests leave, tested in batches, in order. Their loads are started as
+// they are added: a pair's partner segment lies anywhere in memory. Then, per batch:
+// near_pair of every pair (independent, so their chains of vector operations overlap;
+// tested one at a time, each would wait on the last one's branches), the full tests they
+// leave as a list (written without a branch: about a third of the directions go either
+// way), and those tests two at a time (masses_in_2). The contacts come out as testing
+// each pair in turn appends them: masses of i in j, then of j in i.
 class PairBatch {
  public:
   PairBatch(const SegmentGrid& g, const WispSystem& s, std::vector<WispContact>& out) : g_(g), s_(s), out_(out) {}
@@ -349,8 +349,8 @@ void contacts(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std:
     // Segments less than three apart along a wisp are no pair. A wisp's segments are
     // consecutive in seg, so these are the ones after i up to its wisp's end: the later
     // segments j of i's cells pair with it from first_pair on, which the box tests check
-    // (issue 10: checking wisp[j] per pair left, it put the load of j on the path of the
-    // next pair's).
+    // (checking wisp[j] per pair left would put the load of j on the path of the next
+    // pair's).
     std::uint32_t first_pair = i32 + 1;
     while (first_pair < i32 + 3 && first_pair < g.size() && g.wisp[first_pair] == g.wisp[i]) ++first_pair;
     const Eigen::Vector3i& lo = g.cell_lo[i];

@@ -234,7 +234,7 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k] = a;
   }
   // Linear damped axial springs (§3.2).
-  // Each segment's length and direction are kept for the bending springs (issue 10).
+  // Each segment's length and direction are kept for the bending springs.
   for (std::uint32_t k = b + 1; k < e; ++k) {
     const Vec3f d = s.x[k] - s.x[k - 1];
     const float len = d.norm();
@@ -260,7 +260,7 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
   // not grow with stretch, so the spring derives from the energy k L0^2 angle^2 / 2 (up
   // to the frame's twist about the segment): read in the bisecting section frame
   // itself, the target turned with only half of that segment and half of the one
-  // before, which takes no reaction - a follower load whose flutter grew from rounding
+  // before, which takes no reaction - a follower load whose flutter grows from rounding
   // on a still head without gravity above k ~ 1e4 at 1000 Hz.
   for (std::uint32_t k = b + 2; k < e; ++k) {
     const float len = s.seg_len[k], len_prev = s.seg_len[k - 1];
@@ -287,10 +287,10 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     s.acc[k - 1] -= fk + fk2 - damp;
   }
   // A wisp pinned at its tip as well (TressFX strands pinned at both ends) ends in a
-  // single pinned node, not in a pinned segment as at the root (§3.2): nothing held the
-  // direction of its last free segment, which swung about the pinned node like a ball
-  // joint - on tressfx_ponytail_shake the tips of the folded curls turned over by 100
-  // degrees within 5 frames, and the strands rebuilt on them stretched past 50%. The
+  // single pinned node, not in a pinned segment as at the root (§3.2): nothing else holds
+  // the direction of its last free segment, which would swing about the pinned node like
+  // a ball joint - on tressfx_ponytail_shake the tips of the folded curls would turn over
+  // by 100 degrees within 5 frames, and the strands rebuilt on them stretch past 50%. The
   // last segment gets the bending spring the first free one gets from the pinned root
   // segment: towards its head-carried rest direction, the head taking the reaction.
   if (e - b >= 3 && s.pinned[e - 1] && !s.pinned[e - 2]) {
@@ -409,8 +409,8 @@ int nearest_sphere(std::span<const Vec4f> spheres, const Vec3f& p, float& gap) {
 // outside: of the points of that sphere it is moved to the one nearest x at the
 // spring's rest length `len` from prev, so that a mass found deep inside (a body that moved fast, a
 // groom that starts inside) comes out without stretching its segment - moved straight
-// out, a mass 2 cm inside stretched a 1.7 cm segment by half and the strands rebuilt on
-// it past the 50% edge bound. prev may lie on that sphere itself (pushed there at this
+// out, a mass 2 cm inside would stretch a 1.7 cm segment by half and the strands rebuilt
+// on it past the 50% edge bound. prev may lie on that sphere itself (pushed there at this
 // detection). When no such point exists (prev deep inside, or too far) the mass is
 // moved straight out.
 Vec3f push_out(const Vec3f& c, float R, const Vec3f& prev, const Vec3f& x, float len) {
@@ -473,7 +473,7 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
     any_moved = any_moved || moved;
   }
   // The frames follow the skeleton (wisp_positions built them from this state unless a
-  // mass was moved; issue 10).
+  // mass was moved).
   if (any_moved) wisp_frames(s, w, root_e1);
   // Then the envelope masses, each along its half-line.
   for (std::uint32_t k = b; k < e; ++k) {

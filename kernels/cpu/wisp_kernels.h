@@ -87,7 +87,7 @@ struct WispSystem {
   // Body contacts found at the last body-collision detection (sphere index, -1 none).
   std::vector<std::int32_t> node_body, env_body;
   // Per wisp, whether that detection recorded any: the others' sliding contacts and
-  // holds have nothing to do (issue 10).
+  // holds have nothing to do.
   std::vector<std::uint8_t> wisp_touches;
   // The same contacts as lists of nodes (wisp_body_list), for plante_wisp's passes
   // between detections: wisp w's from body_list[5 node_begin[w]], in 5 slots (the
@@ -145,7 +145,7 @@ struct NodeSection {
 NodeSection node_section(const WispSystem& s, std::uint32_t k, const Eigen::Matrix3f& head_rot);
 // strand_point from every node's NodeSection (`sections`, by node index), with the same
 // bits: plante_wisp's rebuild sets each node's up once per step instead of twice per
-// strand vertex that lies near it (issue 10).
+// strand vertex that lies near it.
 Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& coord, const NodeSection* sections);
 // frame_weight interpolated like the section of strand_point at coordinate sfrac.
 float section_weight(const WispSystem& s, std::uint32_t k, float sfrac);
@@ -219,8 +219,9 @@ void wisp_body_detect(WispSystem& s, std::size_t w, const BodyStep& body, const 
 // mass is held at the entry point (no nearer than the radius floor) and its outward
 // radial rate, which would carry it in, is removed. Run after every position update, so
 // each correction is one step's worth of motion: an inelastic wall. Corrected only at the
-// detections, the radial spring drove the mass a period's worth into the head, and the
-// reaction's jump back re-compressed the spring 120 times a second (see wisp_body_slide).
+// detections, the radial spring would drive the mass a period's worth into the head, and
+// the reaction's jump back would re-compress the spring 120 times a second (see
+// wisp_body_slide).
 void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body);
 
 // Sliding contact (§4.2, a velocity modification) for the masses recorded by the last
@@ -231,8 +232,8 @@ void wisp_body_hold(WispSystem& s, std::size_t w, const BodyStep& body);
 void wisp_body_slide(WispSystem& s, std::size_t w, const BodyStep& body, float drag);
 
 // The contacts of wisp w's last detection as lists (body_list): plante_wisp's passes
-// between two detections visit only these (issue 10: on `shake` 2% of the masses are in
-// contact), 16 at a time (wisp_soa.h, body_slide and body_hold).
+// between two detections visit only these (on `shake` 2% of the masses are in contact),
+// 16 at a time (wisp_soa.h, body_slide and body_hold).
 void wisp_body_list(WispSystem& s, std::size_t w);
 // The lists' slots: skeleton masses, then envelope masses q = 0..3.
 inline constexpr std::uint32_t kBodyListSlots = kEnvelopePerSection + 1;
@@ -255,9 +256,9 @@ struct WispContact {
 // and normal to t (t_orth where that vanishes), e2 = t x e1, alpha = lateral.e1, beta =
 // lateral.e2, and ra, rb the radii of the envelope masses on the sides of alpha and beta
 // interpolated at u: (alpha/ra)^2 + (beta/rb)^2 < 1. The axis is set up once per
-// detection for the tests of many points (issue 10; the test: wisp_grid_kernel.cpp).
-// One cache line each (issue 10: the narrow phase reads the volumes of a segment's
-// partners in no order the prefetcher follows).
+// detection for the tests of many points (the test: wisp_grid_kernel.cpp).
+// One cache line each: the narrow phase reads the volumes of a segment's partners in no
+// order the prefetcher follows.
 struct alignas(64) SegmentVolume {
   std::uint32_t a = 0;
   Vec3f xa, d, t, t_orth;  // first node, axis, unit axis and a unit normal to it (len2 > 0)
@@ -289,7 +290,7 @@ struct alignas(64) SegmentVolume {
 void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,
                            std::span<const WispParams> params, float h);
 
-// The same response in two parts, for threads (issue 10): each contact's impulse depends
+// The same response in two parts, for threads: each contact's impulse depends
 // only on the state before the response, so the impulses of any ranges of contacts can be
 // found at once; the sums per mass then run in list order, each thread over the masses of
 // its own nodes, so every mass gets the same bits as from wisp_contacts_respond.

@@ -41,9 +41,9 @@ inline F3 unit(F3 v, int& bad) {
 
 #if defined(__AVX512F__)
 // A 16 x 16 transpose: element j of r[l] becomes element l of r[j]. With it, 16 runs of
-// 16 floats (one a lane) become 16 rows of one float a lane (issue 10: instead of 16
-// scalar moves a row). (GCC 12 warns that the unpack intrinsics' internal undefined
-// operand may be uninitialised; it is a false positive, as in soa_rows.h.)
+// 16 floats (one a lane) become 16 rows of one float a lane, instead of 16 scalar moves a
+// row. (GCC 12 warns that the unpack intrinsics' internal undefined operand may be
+// uninitialised; it is a false positive, as in soa_rows.h.)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 inline void transpose16(__m512* r) {

@@ -1,11 +1,11 @@
 // The integration of Plante et al. 2001 (§5.1 steps 1, 3 and 4: forces, velocities,
-// positions and section frames) for a block of kLanes wisps at once, one wisp per lane
-// (issue 10). Every lane performs the floating-point operations of the per-wisp kernels
+// positions and section frames) for a block of kLanes wisps at once, one wisp per lane.
+// Every lane performs the floating-point operations of the per-wisp kernels
 // (wisp_kernels.h) in their order, so a wisp gets the same bits either way; the per-wisp
 // kernels stay the reference (plante_wisp_ref) and take over for any wisp of a block that
 // meets one of their rare branches (a zero-length segment, a frame fallback axis, a
-// half-turn minimal rotation). Compiled once per ISA variant and chosen at run time,
-// like the Han and Halén block kernels (kernels/CMakeLists.txt).
+// half-turn minimal rotation). Compiled once per ISA variant and chosen at run time, like
+// the Han and Halén block kernels (kernels/CMakeLists.txt).
 #pragma once
 
 #include "kernels/cpu/wisp_kernels.h"
@@ -45,8 +45,8 @@ using ContactsFn = void (*)(const SegmentGrid& g, const WispSystem& s, std::size
 
 // What contact_impulse reads of a node, as two rows of 16 floats: the impulse kernel
 // takes a contact's point node and its segment's two nodes as whole rows, 16 contacts at
-// a time, and turns them into lanes by transposes (issue 10: the copies lane by lane,
-// about 45 a contact, took most of the kernel's time). Copies of the state, so the
+// a time, and turns them into lanes by transposes (copied lane by lane, about 45 moves a
+// contact, they would take most of the kernel's time). Copies of the state, so the
 // lanes get the bits they would read from it.
 struct alignas(64) ContactNode {
   enum : int { kX = 0, kV = 3, kN = 6, kR = 9, kRRest = 13, kEnvelopeMass = 14 };  // row `a`
@@ -86,7 +86,7 @@ struct BodyLanes {
 // plante_wisp's wisp-body passes between detections for the wisps [first, first +
 // count), over the contacts wisp_body_list listed: wisp_body_slide (its skeleton
 // masses, then its envelope masses) and wisp_body_hold, 16 masses at a time, with the
-// per-wisp kernels' bits (issue 10).
+// per-wisp kernels' bits.
 using BodySlideFn = void (*)(WispSystem& s, std::uint32_t first, std::uint32_t count, const BodyLanes& body,
                              float drag);
 using BodyHoldFn = void (*)(WispSystem& s, std::uint32_t first, std::uint32_t count, const BodyLanes& body);

@@ -82,8 +82,8 @@ struct Block {
       __m512 r[16];
       for (int l = 0; l < 16; ++l) r[l] = _mm512_maskz_loadu_ps(tail, run[l] + k0);
       transpose16(r);
-      // Unrolled, so that the rows are stored from registers: as a loop GCC copied the
-      // transposed rows to the stack and on with `rep movsq` (issue 10).
+      // Unrolled, so that the rows are stored from registers: as a loop GCC copies the
+      // transposed rows to the stack and on with `rep movsq`.
 #pragma GCC unroll 16
       for (int j = 0; j < 16; ++j)
         if (j < take) _mm512_storeu_ps(rows + (k0 + j) * W, r[j]);
@@ -343,7 +343,7 @@ void positions(WispSystem& s, const std::uint32_t* wisps, int count, const Vec3f
   const int n = blk.n;
   // The new positions and radii go to arrays of their own: a lane-wise choice written back
   // over its input compiles to a masked store, which the loads after it cannot be
-  // forwarded from (issue 10).
+  // forwarded from.
   V3 x_old[N], x[N], v[N], e1[N], e2[N], nn[N];
   float free[N * W], r_rest[N * W], r_old[N * Q * W], rdot_old[N * Q * W], r[N * Q * W], rdot[N * Q * W];
   blk.load(x_old, s.x);

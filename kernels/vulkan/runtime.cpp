@@ -287,9 +287,8 @@ std::uint32_t Context::memory_type(std::uint32_t allowed, Memory where) const {
   // Device memory the host reads through its caches (CPU devices, integrated GPUs) is
   // taken and mapped. A discrete GPU's host-visible device memory (the PCI BAR) is not
   // cached: on an H200, reading tressfx_ponytail_shake's 1.3 MB of guide positions
-  // through it took 50 ms a frame (25 MB/s), so there plain device memory is taken and
-  // read back through a staging copy (Readback): the whole follow-hair stage, rebuild
-  // included, then took 1 ms.
+  // through it takes about 50 ms a frame (25 MB/s), so there plain device memory is taken
+  // and read back through a staging copy (Readback).
   std::vector<VkMemoryPropertyFlags> wanted;
   if (where == Memory::Device)
     wanted = {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | cached, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0};
@@ -356,8 +355,8 @@ void Context::submit_and_wait(VkCommandBuffer cmd, VkFence fence) const {
   submit.pCommandBuffers = &cmd;
   {
     // The queue is externally synchronized (Vulkan spec, vkQueueSubmit): the runner reads
-    // several models' positions at once from the pool's threads, and on an H200 two
-    // unserialized submissions lost the device.
+    // several models' positions at once from the pool's threads, and unserialized
+    // submissions can lose the device (they do on an H200).
     const std::lock_guard lock(queue_mutex_);
     check(api.vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit");
   }

@@ -53,7 +53,7 @@ std::span<T> CascadeModel::strand(std::vector<T>& v, std::size_t s) {
   return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));
 }
 
-// Visits every awake strand; a sleeping strand is not touched (issue 8).
+// Visits every awake strand; a sleeping strand is not touched.
 template <class F>
 void CascadeModel::for_each_strand(F&& f) {
   ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
@@ -66,7 +66,7 @@ void CascadeModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
   const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm && sleep_.all_asleep()) {
-    // Every strand sleeps: not even the per-strand checks run (issue 8).
+    // Every strand sleeps: not even the per-strand checks run.
     for (std::string_view stage : {"references", "integrate", "length", "collision"}) times.skip(stage);
     return;
   }

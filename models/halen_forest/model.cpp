@@ -73,7 +73,7 @@ k::ForestStrand ForestModel::strand_view(std::size_t s) {
           std::span(pos_).subspan(b, n)};
 }
 
-// Visits every awake strand; a sleeping strand is not touched (issue 8).
+// Visits every awake strand; a sleeping strand is not touched.
 template <class F>
 void ForestModel::for_each_strand(F&& f) {
   ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
@@ -90,8 +90,8 @@ void ForestModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
   const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm && sleep_.all_asleep()) {
-    // Every strand sleeps: not even the per-strand checks run (issue 8). The head has
-    // been still for kQuietFrames frames, so head_hist_ already holds it.
+    // Every strand sleeps: not even the per-strand checks run. The head has been still
+    // for kQuietFrames frames, so head_hist_ already holds it.
     for (std::string_view stage : {"pose", "integrate"}) times.skip(stage);
     return;
   }

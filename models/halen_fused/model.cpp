@@ -262,7 +262,7 @@ void HalenFusedModel::run_thread(int t) {
       ts.sampled_ns +=
           std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
     if (asleep == 0) continue;
-    // A sleeping strand is not touched (issue 8): its lane's state is put back.
+    // A sleeping strand is not touched: its lane's state is put back.
     for (int l = 0; l < W; ++l)
       if (b.strand[l] != kNoStrand && !write[l])
         for (std::size_t k = static_cast<std::size_t>(l); k < floats; k += W) state[k] = backup[k];
@@ -336,7 +336,7 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
   const bool forest = model_ == Model::Forest;
   calm_ = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm_ && sleep_.all_asleep()) {
-    // Every strand sleeps: nothing runs (issue 8). The forest's head has been still for
+    // Every strand sleeps: nothing runs. The forest's head has been still for
     // kQuietFrames frames, so head_hist_ already holds it.
     if (forest)
       for (std::string_view stage : {"pose", "integrate"}) times.skip(stage);

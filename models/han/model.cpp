@@ -40,7 +40,7 @@ void HanModel::reset(const Groom& rest, const ParamSet& params) {
     rs.length_iterations = params.get_int("length_iterations", r);
     const int method = params.get_int("method", r);
     rs.method = method == 0 ? method_ : static_cast<Method>(method);
-    // Issue 8: a pass whose stiffness or reach is 0 changes nothing, so it is not run.
+    // A pass whose stiffness or reach is 0 changes nothing, so it is not run.
     rs.global_pass = !ctx_.skip_inert || (rs.global_stiffness != 0.0f && rs.global_range != 0.0f);
     rs.local_pass = rs.local_iterations > 0 && (!ctx_.skip_inert || rs.local_stiffness != 0.0f);
     any_global_pass_ = any_global_pass_ || rs.global_pass;
@@ -69,7 +69,7 @@ void HanModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
   const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm && sleep_.all_asleep()) {
-    // Every strand sleeps: not even the per-strand checks run (issue 8).
+    // Every strand sleeps: not even the per-strand checks run.
     for (std::string_view stage : {"integrate", "global_shape", "local_shape", "length", "collision"}) times.skip(stage);
     return;
   }

@@ -23,7 +23,7 @@ class HanModel final : public HairModel {
   void reset(const Groom& rest, const ParamSet& params) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
-  // Every array a frame reads or writes (the roofline's streaming floor, issue 10).
+  // Every array a frame reads or writes (the roofline's streaming floor).
   std::size_t state_bytes() const override {
     return (pos_.size() + prev_.size() + rest_.positions.size()) * sizeof(Vec4f) +
            rest_length_.size() * sizeof(float) +

@@ -33,7 +33,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
     p.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
     const float range = static_cast<float>(params.get("global_range", r));
     p.global_ramp = params.get_int("global_ramp", r) != 0;
-    // Issue 8: a pass whose stiffness or reach is 0 changes nothing and is not run (unless
+    // A pass whose stiffness or reach is 0 changes nothing and is not run (unless
     // ModelContext::skip_inert is off, the reference for that claim).
     p.global_on = !ctx_.skip_inert || (p.global_stiffness != 0.0f && range != 0.0f);
     p.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
@@ -308,7 +308,7 @@ void HanFusedModel::observe_sleep(int t, float dt) {
 void HanFusedModel::step(const FrameInput& in, StageTimes& times) {
   calm_ = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm_ && sleep_.all_asleep()) {
-    // Every strand sleeps: nothing runs (issue 8).
+    // Every strand sleeps: nothing runs.
     for (std::string_view stage : {"integrate", "global_shape", "local_shape", "length", "collision"}) times.skip(stage);
     return;
   }

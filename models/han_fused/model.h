@@ -78,7 +78,7 @@ class HanFusedModel final : public HairModel {
   int substeps_ = 1;
   bool any_global_ = false, any_local_ = false, any_length_ = false;
 
-  // Sleeping strands (issue 8, core/sleep.h): a block whose strands all sleep is not
+  // Sleeping strands (core/sleep.h): a block whose strands all sleep is not
   // run; a block with some asleep runs whole and its sleepers' lanes and positions are
   // put back from copies (backup_ and pos_backup_, per thread), so they stay
   // bit-exactly as they were.

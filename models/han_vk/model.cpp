@@ -47,12 +47,11 @@ namespace {
 // parallel along the strand. Method 1's local shape step is one serial walk per strand
 // (Algorithm 3) by one invocation: with half as many invocations per strand, a workgroup
 // holds twice the walkers. That pays where the strands are long enough for the walk to
-// dominate and the groom fills the GPU with workgroups even so. Measured on an H200
-// (han_m1_vk device ms per frame, HAIRBENCH_VK_LANES sweep, default -> half): Table 1
-// model 1 0.117 -> 0.100, model 2 0.127 -> 0.104, model 3 3.80 -> 2.44, TressFX ponytail
-// (shake) 0.264 -> 0.223, mohawk 0.191 -> 0.167. Kept: shake (2,000 strands, 250
-// workgroups at half: 0.050 -> 0.057) and TestHair1 (4-vertex strands: 0.039 -> 0.043).
-// Methods 2 and 3 were fastest at their default on every groom of BM_HanVk.
+// dominate and the groom fills the GPU with workgroups even so (on an H200: Table 1's
+// grooms and the TressFX ponytail and mohawk, but not `shake`'s 2,000 strands, 250
+// workgroups at half, nor TestHair1's 4-vertex strands; HAIRBENCH_VK_LANES overrides the
+// choice for such sweeps). Methods 2 and 3 are fastest at their default on every groom of
+// BM_HanVk.
 constexpr std::size_t kMethod1MinVertices = 8;
 constexpr std::size_t kMethod1MinGroups = 512;
 

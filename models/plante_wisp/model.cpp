@@ -24,7 +24,7 @@ Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
 // the root weighs as much as the rest of the strand together, so wisps stay compact at
 // the scalp, where the strands are pinned and the rebuild cannot bend them apart.
 // The terms are never negative, so the partial sums only grow: once one exceeds `bound`
-// the strand is farther than that, and the sum so far is returned (issue 10).
+// the strand is farther than that, and the sum so far is returned.
 float strand_distance2(const Groom& g, std::uint32_t s, const std::vector<Vec3f>& centre, std::size_t j, std::size_t n,
                        float bound) {
   const std::uint32_t b = g.strand_begin(s);
@@ -260,7 +260,7 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   // Blocks of the fused schedule: consecutive wisps of one node count and params set
   // (k-means clusters of one region and strand size are consecutive, cluster()). A block
   // costs about as much as 7 wisps through the per-wisp kernels whatever its lanes in
-  // use (issue 10: 2.3 times faster for 16), so it takes runs of at least half its lanes.
+  // use, so it takes runs of at least half its lanes.
   runs_.clear();
   constexpr std::uint32_t lanes = k::wisp_soa::kLanes, kMinBlockLanes = lanes / 2;
   const auto wisps = static_cast<std::uint32_t>(sys_.wisp_count());
@@ -278,9 +278,8 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   const std::size_t threads = ctx_.pool ? static_cast<std::size_t>(ctx_.pool->threads()) : 1;
   // The threads' shares of the runs, of about equal cost rather than equal counts: a
   // wisp through the per-wisp kernels costs about a seventh of a block (above), and such
-  // wisps gather where the groom has them (issue 10: tressfx_ponytail_shake's 488 single
-  // wisps, before tip-pinned wisps ran in blocks, lay mostly at the end of the list; with
-  // equal counts of runs two threads ran the integration only 1.3 times as fast as one).
+  // wisps gather where the groom has them (where they lie mostly at the end of the list,
+  // equal counts of runs would leave most of the integration to one thread).
   constexpr std::uint64_t kBlockCost = 7;
   std::vector<std::uint64_t> cost_before(runs_.size() + 1, 0);
   for (std::size_t i = 0; i < runs_.size(); ++i)
@@ -302,7 +301,7 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   rebuild(Affine3f::Identity());
 }
 
-// Stage times inside a fused pass (issue 10): every kTimingSample-th wisp is timed stage
+// Stage times inside a fused pass: every kTimingSample-th wisp is timed stage
 // by stage, and the pass's measured time is split between the stages in those
 // proportions (as the fused Han kernel samples its blocks).
 constexpr std::size_t kTimingSample = 8;
@@ -359,8 +358,8 @@ void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
   const auto start = std::chrono::steady_clock::now();
   // Each thread takes the runs of its range (run_bounds_, of about equal estimated
   // cost) from the front; one that runs out takes the other ranges' runs from their back
-  // (issue 10: the body contacts gather on some wisps; on `shake` the first thread worked
-  // 812 ms of the passes' 836 and the second 598). A thread keeps nearly the same wisps
+  // (the body contacts gather on some wisps, so equal estimated costs can still leave one
+  // thread far busier than the other). A thread keeps nearly the same wisps
   // from step to step, in its cache, and which thread steps a wisp changes no bits.
   const std::size_t parts = run_bounds_.size() - 1;
   for (std::size_t p = 0; p < parts; ++p)
@@ -417,8 +416,8 @@ void PlanteWispModel::detect_self_interactions() {
   if (schedule_ == Schedule::PerStage) {
     k::grid_cells(grid_);
   } else {
-    // The cells' loops over the segments on the threads (issue 10: serial, they were
-    // 1.1 ms of a detection's 8 on shake at 2 threads).
+    // The cells' loops over the segments on the threads (serial, they would take about an
+    // eighth of a detection's time on shake at 2 threads).
     k::grid_frame(grid_, threads);
     const std::size_t parts = grid_.part_begin.size() - 1;
     auto over_parts = [&](auto step) {
@@ -432,13 +431,13 @@ void PlanteWispModel::detect_self_interactions() {
   }
   // Chunks of about equal candidates (grid_split), several per thread, claimed as the
   // threads come free: a chunk's cost also depends on how many of its candidates are
-  // contacts, which no count ahead of the test knows (issue 10: with one chunk of equal
-  // candidates per thread, one thread took 1.35 times as long as the other on model 1).
+  // contacts, which no count ahead of the test knows (with one chunk of equal candidates
+  // per thread, one thread would take markedly longer than the other on model 1).
   k::grid_split(grid_, chunks, chunk_bounds_);
   std::atomic<std::size_t> next{0};
   auto run = [&](std::size_t tb, std::size_t te) {
     for (std::size_t t = tb; t < te; ++t) {
-      // plante_wisp_ref: the narrow phase as first written, the reference of the vector
+      // plante_wisp_ref: the plain narrow phase, the reference of the vector
       // one. A segment is tested once by one thread, so a thread's mailbox serves all its
       // chunks.
       std::vector<std::uint32_t>& mailbox = thread_mailbox_[t];
@@ -483,8 +482,8 @@ void PlanteWispModel::respond_to_contacts(float h) {
     block_.impulses(sys_, contact_nodes_.data(), contacts_, begin, end, interaction_, params_, h, impulses_.data());
   });
   // The threads' node ranges hold about equal contacts, not equal nodes: contacts gather
-  // where the hair is dense (issue 10: on model 1, with equal nodes, one thread summed 5
-  // times as many as the other, and 2 threads were 1.2 times as fast as 1). A chunk's
+  // where the hair is dense (on model 1, equal nodes would give one thread about 5 times
+  // as many contacts to sum as the other). A chunk's
   // contacts each touch a node of its own segments (the tested mass's or the volume's),
   // so the ranges are cut at the chunks that split the list evenly. Any cut gives the
   // same sums.
@@ -509,7 +508,7 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     for (std::string_view stage : {"integration", "body_collision", "self_interaction", "rebuild"}) times.skip(stage);
     return;
   }
-  // Issue 8: without colliders there is no body pass at all, and the report says so;
+  // Without colliders there is no body pass at all, and the report says so;
   // --no-skip runs the pass over no spheres.
   const bool body_pass = !in.colliders.empty() || !ctx_.skip_inert;
   if (!body_pass) times.skip("body_collision");
@@ -530,15 +529,16 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // Bodies (§4.2): a mass the last detection found within the contact threshold is in
     // sliding contact until the next detection, so the modification (approach removed,
     // tangential slip dragged) applies on every integration step in between, not only on
-    // the detecting one. Applied once per detection, the masses sank into the body again
-    // between detections under gravity and their springs, and the penetration reaction
-    // threw them back out: on `idle` the position jumps re-loaded the stiff axial springs
-    // 120 times a second and held the hair in a 0.4 m/s jitter that never settled.
+    // the detecting one. Applied once per detection, the masses would sink into the body
+    // again between detections under gravity and their springs, and the penetration
+    // reaction throw them back out: on `idle` the position jumps would re-load the stiff
+    // axial springs 120 times a second and hold the hair in a 0.4 m/s jitter that never
+    // settles.
     const bool body_on = collision_hz_ > 0.0 && body_pass;
     // Also on the first step after reset: the sliding contacts above hold until the next
     // detection, and a groom that starts inside a body would otherwise sink into it for
     // a whole period before its first detection (the stress test's `inside_collider`:
-    // the wisps wrapped round the sphere from 8 ms deep, rebuilt strands 55% long).
+    // the wisps would wrap round the sphere from 8 ms deep, rebuilt strands 55% long).
     const bool body_due = body_on && (crosses(collision_hz_, i) || i == steps || !contacts_known_);
     contacts_known_ = contacts_known_ || body_due;
     k::BodyStep body;
@@ -616,13 +616,13 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
     // the time step"). After the bodies' modifications: a mass pressed against the head
     // carries, after the force update, the step's worth of velocity into it (a h) that
-    // the sliding contact removes; seen by this response, it was handed on to the wisps
-    // touching that mass, and kept those on `idle` moving at up to 2 cm/s, 24 times a
-    // second.
+    // the sliding contact removes; seen by this response, it would be handed on to the
+    // wisps touching that mass, and keep those on `idle` moving at up to 2 cm/s, 24 times
+    // a second.
     const bool interact = crosses(interaction_hz_, i);
     if (schedule_ == Schedule::PerStage) {
       // plante_wisp_ref: the same stages in the same order, one pass over all wisps each
-      // (the schedule before issue 10; it reads every wisp's state once per stage).
+      // (the plain schedule; it reads every wisp's state once per stage).
       stage_pass(times, "integration", [&](std::size_t w) {
         k::wisp_pin(sys_, w, head, h);
         k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head_rot, in.gravity, in.wind, h);
@@ -678,16 +678,17 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
 // or behind the wisp's pinned nodes along its axis (the wisp's nodes are its strands'
 // mean vertices): when the wisp's first free segment turns by an angle about its pinned
 // node, the section point of a pinned vertex turns with it while the vertex does not,
-// and the first free edge changed length by up to half a segment times that angle
-// (0.5-1.4 of its rest length on ponytail, spin_fast, tilt_upside_down, wind_gust).
+// and, left alone, the first free edge would change length by up to half a segment
+// times that angle (0.5-1.4 of its rest length on ponytail, spin_fast,
+// tilt_upside_down, wind_gust).
 // The gap between the last pinned vertex and its section point (`anchor`) is carried
 // by the free vertices, fading with the section weight that already blends the axes
 // near the root (root_blend), so the strand stays attached to its root.
 void PlanteWispModel::rebuild(const Affine3f& head) {
   const Eigen::Matrix3f head_rot = head.linear();
   // plante_wisp sets up each node's part of the section frames once, then a strand's
-  // points 16 vertices at a time (issue 10); plante_wisp_ref, as first written, computes
-  // each point alone, the two nodes' parts included. Same bits.
+  // points 16 vertices at a time; plante_wisp_ref computes each point alone, the two
+  // nodes' parts included. Same bits.
   const bool per_node = schedule_ == Schedule::Fused;
   if (per_node) {
     for_each(sys_.node_count(), [&](std::size_t begin, std::size_t end) {

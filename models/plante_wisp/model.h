@@ -21,10 +21,10 @@
 
 namespace hairbench::plante {
 
-// How a step visits the wisps (issue 10). Fused: each wisp goes through all of a step's
-// stages in one pass while it is in cache (plante_wisp). PerStage: one pass over all
-// wisps per stage, the schedule before issue 10, kept as plante_wisp_ref; both run the
-// same kernels in the same order per wisp, so their results are bit-identical.
+// How a step visits the wisps. Fused: each wisp goes through all of a step's stages in
+// one pass while it is in cache (plante_wisp). PerStage: one pass over all wisps per
+// stage (plante_wisp_ref, the reference); both run the same kernels in the same order
+// per wisp, so their results are bit-identical.
 enum class Schedule { Fused, PerStage };
 
 class PlanteWispModel final : public HairModel {
@@ -87,7 +87,7 @@ class PlanteWispModel final : public HairModel {
   double integration_hz_ = 1000, collision_hz_ = 120, interaction_hz_ = 24;
   int threads_min_wisps_ = 64;
   // Wisps touch each other, so the hair sleeps as a whole: one "strand" in StrandSleep
-  // that stands for every wisp (issue 8).
+  // that stands for every wisp.
   StrandSleep sleep_;
 
   kernels::WispSystem sys_;

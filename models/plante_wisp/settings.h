@@ -17,8 +17,8 @@
 // wisp_forces_and_velocities); their zigzag mode has omega^2 ~ 16 k, so explicit
 // integration at 1000 Hz holds up to k ~ 2.5e5 (measured on `idle` without gravity:
 // still at 2e5, blown up at 5e5). 1e5 (omega h ~ 1.3) is the stiffest default with that
-// margin; it holds the style against metric gravity far better than the old 5e3
-// (rest_shape_error on `idle` 0.08 L-bar instead of 0.13), though a 25 cm wisp of unit
+// margin; it holds the style against metric gravity far better than 5e3
+// (rest_shape_error on `idle` 0.08 L-bar against 0.13), though a 25 cm wisp of unit
 // node masses would need ~6e5 to hold its root within 0.1 rad (nothing but bending
 // holds the style, §3.2). Stiffer bending also bounds the bend changes at the nodes,
 // which the rebuilt strands turn into edge length error (wisp_width_max). None of

@@ -220,8 +220,7 @@ FOLLOW_CLONES void apply_range(const FollowHairs& follow, std::span<const Vec4f>
     }
     // guide + d.x t + d.y n + d.z b, component by component in Eigen's order for that
     // expression (((g + d.x t) + d.y n) + d.z b): the same bits as the Vec3d expression,
-    // in a loop GCC vectorises (as Eigen expressions it ran one vertex at a time, 4% of
-    // the default `compare`, issue 10).
+    // in a loop GCC vectorises (as Eigen expressions it runs one vertex at a time).
     const std::uint32_t o = follow.follow_offsets[s];
     const Vec3f* off = follow.offsets.data() + o;
     Vec4f* out = out_follow_positions.data() + o;
