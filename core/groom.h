@@ -32,7 +32,7 @@ struct Groom {
 // Per-edge rest lengths, indexed by the edge's second vertex (entry at a strand's first
 // vertex is 0), so kernels address edges and vertices with one index.
 std::vector<float> rest_edge_lengths(const Groom& g);
-// Mean rest strand length L-bar (DESIGN.md, metrics).
+// Mean rest strand length L-bar (docs/metrics.md).
 double mean_strand_length(const Groom& g);
 
 // Every `keep_every`-th strand of g (strands 0, n, 2n, ...), with its region: a thinner

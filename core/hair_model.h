@@ -1,4 +1,4 @@
-// The interface every hair model implements (DESIGN.md, "Model interface").
+// The interface every hair model implements (docs/architecture.md).
 #pragma once
 
 #include "core/groom.h"

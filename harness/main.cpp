@@ -1,9 +1,11 @@
-// hairbench command line (DESIGN.md, "CLI (contract)").
+// hairbench command line: one CLI11 application with a subcommand per task. Every bad
+// argument is one line on stderr, "hairbench: arguments: WHAT: what is wrong", and exit
+// code 2, like every other bad input.
 #include "core/error.h"
 #include "core/parallel.h"
+#include "git_sha.h"
 #include "harness/charts.h"
 #include "harness/progress.h"
-#include "harness/args.h"
 #include "harness/reproduce.h"
 #include "harness/runner.h"
 #include "harness/stress.h"
@@ -14,6 +16,9 @@
 #include "kernels/vulkan/runtime.h"
 #endif
 
+#include <CLI/CLI.hpp>
+
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -29,46 +34,45 @@
 namespace hairbench {
 namespace {
 
-constexpr const char* kUsage = R"(usage:
-  hairbench list models|scenarios|devices
-  hairbench compare [--scenario NAME|PATH]... [--models REGEX] [--reference MODEL|converged]
-                    [--frames N] [--threads N] [--set MODEL.NAME=VALUE]... [--out DIR] [--no-charts]
-                    [--device NAME|INDEX] [--no-skip]
-  hairbench sweep --scenario NAME|PATH [--scenario ...] --knob NAME=V1,V2,... [--models REGEX]
-                  [--reference MODEL|converged] [--frames N] [--threads N] [--set MODEL.NAME=VALUE]...
-                  [--out DIR] [--no-charts]
-  hairbench stress [--models REGEX] [--base SCENARIO] [--axes REGEX] [--keep-every N]
-                   [--quick] [--threads N] [--out DIR] [--no-charts]
-  hairbench reproduce han2012|halen2007|plante2001|all [--frames N] [--threads N]
-                      [--device NAME|INDEX] [--out DIR]
+// Help texts: lines of at most 62 characters, so that the subcommand list of
+// `hairbench --help`, which indents them by 30, stays within 92 columns.
+constexpr const char* kDescription =
+    "hairbench runs hair-simulation models side by side on\n"
+    "scenarios and reports their speed and accuracy.\n"
+    "`hairbench SUBCOMMAND --help` describes each subcommand.";
 
-compare runs every selected model in lockstep on each scenario (default: every built-in
-scenario) and writes DIR/report.json (default DIR: reports/out/latest), then its charts,
-DIR/report_summary.md and DIR/report.html.
-sweep runs every selected model that has parameter NAME at each value, and writes one
-report whose runs carry the value as "knob" (default DIR: reports/out/sweep).
-  --models REGEX     models whose whole name matches (default: all)
-  --reference MODEL  deviation is measured against MODEL (default: the scenario's, han_m1);
-                     converged: han_m1 with 32 local and length iterations and 4 substeps
-  --set M.NAME=V     parameter override; M may be * for every model that has NAME
-  --no-charts        write the report only
-  --no-skip          run every stage even where the scene makes it inert (no colliders,
-                     no wind, zero stiffness) and never let strands sleep
-  --device D         Vulkan device of the *_vk models, by index or name (see list
-                     devices; default: the first discrete GPU, else any device)
-stress escalates one axis at a time (time step, head angular velocity and acceleration,
-teleports, strand vertices and length, every stiffness, iteration count and damping)
-from the stable base scenario (default shake, every 10th strand) until each model fails,
-runs degenerate grooms, prints the table, writes DIR/stress.json (default DIR:
-reports/out/stress) and draws its heatmap DIR/stress_heatmap.png. --quick tries every other value
-of each axis.
-reproduce runs the configurations of the papers' published tables (reports/published/)
-and writes DIR/reproduce.json, .md and .html (default DIR: reports/out/reproduce): per
-row the published and measured values and a hardware-independent comparison, and the
-papers' claims as checks, each with a verdict (holds / differs). --frames N caps every
-run at N frames (quick runs).
-exit codes: 0 done (unstable models are results, not errors), 1 internal error or chart
-script failure, 2 bad arguments or files)";
+constexpr const char* kExitCodes =
+    "exit codes: 0 done (unstable models are results, not errors),\n"
+    "1 internal error or chart script failure, 2 bad arguments or files";
+
+constexpr const char* kListHelp = "list prints the models, the built-in scenarios or the\nVulkan devices.";
+
+constexpr const char* kCompareHelp =
+    "compare runs every selected model in lockstep on each\n"
+    "scenario (default: every built-in scenario) and writes\n"
+    "DIR/report.json, then its charts, DIR/report_summary.md and\n"
+    "DIR/report.html.";
+
+constexpr const char* kSweepHelp =
+    "sweep runs every selected model that has the --knob\n"
+    "parameter at each of its values, and writes one report whose\n"
+    "runs carry the value as \"knob\"; a note names the selected\n"
+    "models that lack the parameter, which are left out.";
+
+constexpr const char* kStressHelp =
+    "stress escalates one axis at a time (time step, head angular\n"
+    "velocity and acceleration, teleports, strand vertices and\n"
+    "length, every stiffness, iteration count and damping) from\n"
+    "the stable base scenario until each CPU model fails, runs\n"
+    "degenerate grooms, prints the table, writes DIR/stress.json\n"
+    "and draws its heatmap DIR/stress_heatmap.png.";
+
+constexpr const char* kReproduceHelp =
+    "reproduce runs the configurations of the papers' published\n"
+    "tables (reports/published/) and writes DIR/reproduce.json,\n"
+    ".md and .html: per row the published and measured values and\n"
+    "a hardware-independent comparison, and the papers' claims as\n"
+    "checks, each with a verdict (holds / differs).";
 
 struct KnobSpec {
   std::string name;
@@ -76,15 +80,19 @@ struct KnobSpec {
 };
 
 struct CompareArgs {
+  // As given on the command line.
   std::vector<std::string> scenarios;
   std::string models = ".*";
   bool models_given = false;
-  std::vector<std::string> skipped;  // models left out, and why (printed once the inputs are good)
-  RunOptions run;
+  std::vector<std::string> sets;   // --set, in order
+  std::vector<std::string> knobs;  // --knob (sweep only, which needs exactly one)
   int threads = 0;
   std::string out;
   bool charts = true;
-  std::optional<KnobSpec> knob;  // sweep only
+  // Resolved by prepare_compare.
+  RunOptions run;
+  std::vector<std::string> skipped;  // models left out, and why (printed once the inputs are good)
+  std::optional<KnobSpec> knob;
 };
 
 // --knob NAME=V1,V2,...: a parameter name and distinct finite numbers.
@@ -136,37 +144,17 @@ void select_knob_models(CompareArgs& a) {
   a.run.models = std::move(kept);
 }
 
-CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
-  CompareArgs a;
-  a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& flag = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw InputError("arguments", flag, "needs a value");
-      return args[++i];
-    };
-    if (flag == "--scenario") a.scenarios.push_back(value());
-    else if (flag == "--models") {
-      a.models = value();
-      a.models_given = true;
-    } else if (flag == "--device") a.run.device = value();
-    else if (flag == "--reference") a.run.reference = value();
-    else if (flag == "--frames") a.run.frames = parse_int(flag, value(), 1, 10'000'000);
-    else if (flag == "--threads") a.threads = parse_int(flag, value(), 1, 1024);
-    else if (flag == "--set") {
-      ParamOverride o = parse_param_override(value());
-      check_param_override(o);
-      a.run.overrides.push_back(o);
-    } else if (flag == "--out") a.out = value();
-    else if (flag == "--no-charts") a.charts = false;
-    else if (flag == "--no-skip") a.run.skip_inert = false;
-    else if (sweep && flag == "--knob") {
-      if (a.knob) throw InputError("arguments", flag, "give one --knob per sweep");
-      a.knob = parse_knob(value());
-    } else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
+// The checks and lookups behind compare's and sweep's options, once CLI11 has read them.
+void prepare_compare(CompareArgs& a, bool sweep) {
+  for (const std::string& set : a.sets) {
+    ParamOverride o = parse_param_override(set);
+    check_param_override(o);
+    a.run.overrides.push_back(o);
   }
-  if (sweep && a.scenarios.empty()) throw InputError("arguments", "sweep", "needs --scenario NAME|PATH");
-  if (sweep && !a.knob) throw InputError("arguments", "sweep", "needs --knob NAME=V1,V2,...");
+  if (sweep) {
+    if (a.knobs.size() != 1) throw InputError("arguments", "--knob", "give one --knob per sweep");
+    a.knob = parse_knob(a.knobs.front());
+  }
   std::regex re;
   try {
     re = std::regex(a.models);
@@ -186,8 +174,8 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
       why = "the Vulkan device is a CPU (" + vk::Context::get(a.run.device)->device().name +
             "); name it in --models to run it";
 #endif
-    // The _ref variants are today's straightforward implementations kept for issue 10's
-    // side-by-side speed-ups; their results are bit-identical to the fast models'.
+    // The _ref variants are the straightforward implementations the fast models are
+    // measured against; their results are bit-identical to the fast models'.
     if (why.empty() && !a.models_given && std::string_view(m.name).ends_with("_ref"))
       why = "bit-identical reference implementation of " + std::string(m.name.substr(0, m.name.size() - 4)) +
             "; name it in --models to run it";
@@ -203,7 +191,6 @@ CompareArgs parse_compare(const std::vector<std::string>& args, bool sweep) {
     throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "' (or 'converged')");
   }
   if (a.knob) select_knob_models(a);
-  return a;
 }
 
 void print_run(const nlohmann::json& r) {
@@ -220,13 +207,19 @@ void print_run(const nlohmann::json& r) {
     return std::string(buf);
   };
   const auto& m = r["metrics"];
-  std::printf("  %-14s %-8s %9s ms %8s ns/v  dev %-9s jag %-9s len %-9s rest %-9s\n", label.c_str(), r["status"].get<std::string>().c_str(),
-              f(r["timing"]["step_ms"]["median"], "%.3f").c_str(), f(r["timing"]["ns_per_vertex"], "%.1f").c_str(),
-              f(m["deviation_vs_reference"]["rms"], "%.3g").c_str(), f(m["jaggedness"]["mean"], "%.3g").c_str(),
-              f(m["length_error"]["rms"], "%.2g").c_str(), f(m["rest_shape_error"], "%.3g").c_str());
-  if (!r["failure"].is_null())
-    std::printf("  %-14s unstable at frame %d: %s\n", "", r["failure"]["frame"].get<int>(),
-                r["failure"]["reason"].get<std::string>().c_str());
+  std::printf("  %-14s %-9s %9s ms %8s ns/v  dev %-9s jag %-9s len %-9s rest %-9s\n", label.c_str(),
+              r["status"].get<std::string>().c_str(), f(r["timing"]["step_ms"]["median"], "%.3f").c_str(),
+              f(r["timing"]["ns_per_vertex"], "%.1f").c_str(), f(m["deviation_vs_reference"]["rms"], "%.3g").c_str(),
+              f(m["jaggedness"]["mean"], "%.3g").c_str(), f(m["length_error"]["rms"], "%.2g").c_str(),
+              f(m["rest_shape_error"], "%.3g").c_str());
+  // Every class but ok says why, and where it was decided.
+  const auto& v = r["verdict"];
+  if (v["class"] != "ok") {
+    std::string at;
+    if (!v["frame"].is_null()) at = " at frame " + std::to_string(v["frame"].get<int>());
+    std::printf("  %-14s %s%s: %s\n", "", v["class"].get<std::string>().c_str(), at.c_str(),
+                v["reason"].get<std::string>().c_str());
+  }
 }
 
 // The report, then the chart step (reports/charts.py) unless --no-charts.
@@ -241,8 +234,7 @@ int write_report(const CompareArgs& a, const ThreadPool& pool, const std::vector
 }
 
 std::vector<Scenario> load_scenarios(const CompareArgs& a) {
-  // Load every scenario before running any, so a bad file fails fast. Built-in
-  // scenarios whose asset is missing are skipped with a message; named ones are errors.
+  // Load every scenario before running any, so a bad file fails fast.
   std::vector<Scenario> scenarios;
   if (a.scenarios.empty()) scenarios = load_builtin_scenarios();
   for (const std::string& s : a.scenarios) scenarios.push_back(load_scenario(find_scenario(s)));
@@ -255,8 +247,8 @@ void print_header(const Scenario& sc, const CompareArgs& a) {
               sc.groom.vertex_count(), a.run.frames > 0 ? a.run.frames : sc.frames);
 }
 
-int cmd_compare(const std::vector<std::string>& args) {
-  CompareArgs a = parse_compare(args, false);
+int cmd_compare(CompareArgs& a) {
+  prepare_compare(a, false);
   const std::vector<Scenario> scenarios = load_scenarios(a);
 
   ThreadPool pool(a.threads);
@@ -281,8 +273,8 @@ int cmd_compare(const std::vector<std::string>& args) {
 
 // Every selected model at every knob value, one lockstep batch per value: the reference
 // (at the scenario's parameters, or converged) is the same in every batch.
-int cmd_sweep(const std::vector<std::string>& args) {
-  CompareArgs a = parse_compare(args, true);
+int cmd_sweep(CompareArgs& a) {
+  prepare_compare(a, true);
   const KnobSpec& knob = *a.knob;
   const std::vector<Scenario> scenarios = load_scenarios(a);
 
@@ -315,42 +307,30 @@ int cmd_sweep(const std::vector<std::string>& args) {
   return write_report(a, pool, runs, records, sweep);
 }
 
-int cmd_stress(const std::vector<std::string>& args) {
+struct StressArgs {
   StressOptions opt;
-  std::string models = ".*", out = "reports/out/stress";
+  std::string models = ".*";
+  std::string out = "reports/out/stress";
   int threads = 0;
-  bool no_charts = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& flag = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw InputError("arguments", flag, "needs a value");
-      return args[++i];
-    };
-    if (flag == "--models") models = value();
-    else if (flag == "--base") opt.base = value();
-    else if (flag == "--axes") opt.axes = value();
-    else if (flag == "--keep-every") opt.keep_every = static_cast<std::size_t>(parse_int(flag, value(), 1, 1'000'000));
-    else if (flag == "--quick") opt.value_stride = 2;
-    else if (flag == "--threads") threads = parse_int(flag, value(), 1, 1024);
-    else if (flag == "--out") out = value();
-    else if (flag == "--no-charts") no_charts = true;
-    else throw InputError("arguments", flag, "unknown option (see hairbench --help)");
-  }
-  // The CPU models: the GPU variants run the same algorithms (issue 7's agreement
-  // tests), and on a CPU Vulkan device a sweep of them would take hours.
+  bool charts = true;
+};
+
+int cmd_stress(StressArgs& a) {
+  // The CPU models: the GPU variants run the same algorithms (the agreement tests),
+  // and on a CPU Vulkan device a sweep of them would take hours.
   std::regex re;
   try {
-    re = std::regex(models);
+    re = std::regex(a.models);
   } catch (const std::regex_error& e) {
     throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
   }
   for (const ModelInfo& m : model_registry())
-    if (!m.unavailable && std::regex_match(std::string(m.name), re)) opt.models.emplace_back(m.name);
-  if (opt.models.empty()) throw InputError("arguments", "--models", "'" + models + "' matches no CPU model");
-  ThreadPool pool(threads);
+    if (!m.unavailable && std::regex_match(std::string(m.name), re)) a.opt.models.emplace_back(m.name);
+  if (a.opt.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no CPU model");
+  ThreadPool pool(a.threads);
   const bool tty = isatty(fileno(stderr));
   const auto start = std::chrono::steady_clock::now();
-  const StressResult result = run_stress(opt, pool, [&](int done, int total) {
+  const StressResult result = run_stress(a.opt, pool, [&](int done, int total) {
     if (!tty) return;
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "\r  stress: %d/%d runs, %.0f s elapsed, ~%.0f s left   ", done, total, s,
@@ -360,26 +340,25 @@ int cmd_stress(const std::vector<std::string>& args) {
   std::fputs(stress_table(result).c_str(), stdout);
   nlohmann::json report = make_report(ReportContext{pool.threads()}, {});
   report["stress"] = stress_json(result);
-  const std::filesystem::path file = std::filesystem::path(out) / "stress.json";
+  const std::filesystem::path file = std::filesystem::path(a.out) / "stress.json";
   write_json(file, report);
   std::printf("wrote %s\n", file.string().c_str());
-  return no_charts ? 0 : draw_charts(file, "stress_chart.py");
+  return a.charts ? draw_charts(file, "stress_chart.py") : 0;
 }
 
-int cmd_list(const std::vector<std::string>& args) {
-  if (args.size() != 1)
-    throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
-  if (args[0] == "models") {
+int cmd_list(const std::string& what) {
+  if (what.empty()) throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
+  if (what == "models") {
     for (const ModelInfo& m : model_registry())
       std::printf("%-14s %s\n", std::string(m.name).c_str(), std::string(m.summary).c_str());
     return 0;
   }
-  if (args[0] == "scenarios") {
+  if (what == "scenarios") {
     for (const Scenario& sc : load_builtin_scenarios())
       std::printf("%-18s %s\n", sc.name.c_str(), sc.description.c_str());
     return 0;
   }
-  if (args[0] == "devices") {
+  if (what == "devices") {
 #ifdef HAIRBENCH_HAS_VULKAN
     try {
       for (const vk::DeviceInfo& d : vk::list_devices())
@@ -392,23 +371,182 @@ int cmd_list(const std::vector<std::string>& args) {
 #endif
     return 0;
   }
-  throw InputError("arguments", "list " + args[0], "expected `list models`, `list scenarios` or `list devices`");
+  throw InputError("arguments", "list " + what, "expected `list models`, `list scenarios` or `list devices`");
+}
+
+// --frames, --threads, --keep-every: a whole number in [lo, hi]. The one place numbers
+// on the command line are checked; CLI11 converts a value only once this accepts it.
+CLI::Validator whole_number(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& v) -> std::string {
+        long long x = 0;
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+        if (ec == std::errc() && end == v.data() + v.size() && x >= lo && x <= hi) return "";
+        return "'" + v + "' is not a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+      },
+      "");
+}
+
+// The options compare and sweep share; sweep adds --knob and needs --scenario.
+void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
+  a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
+  sub.add_option("--scenario", a.scenarios,
+                 sweep ? "built-in scenario or scenario file; repeatable"
+                       : "built-in scenario or scenario file; repeatable\n(default: every built-in scenario)")
+      ->type_name("NAME|PATH")
+      ->allow_extra_args(false)
+      ->required(sweep);
+  if (sweep)
+    sub.add_option("--knob", a.knobs, "the parameter to vary and its values,\ne.g. local_iterations=1,2,4,8")
+        ->type_name("NAME=V1,V2,...")
+        ->expected(1)
+        ->allow_extra_args(false)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)  // prepare_compare refuses a second
+        ->required();
+  sub.add_option("--models", a.models, "models whose whole name matches (default: all)")
+      ->type_name("REGEX")
+      ->each([&a](const std::string&) { a.models_given = true; });
+  sub.add_option("--reference", a.run.reference,
+                 "deviation is measured against MODEL (default: the\n"
+                 "scenario's, han_m1); converged: han_m1 with 32 local and\n"
+                 "length iterations and 4 substeps")
+      ->type_name("MODEL|converged");
+  sub.add_option("--frames", a.run.frames, "frames per run, 1 to 10000000 (default: the scenario's)")
+      ->type_name("N")
+      ->check(whole_number(1, 10'000'000));
+  sub.add_option("--threads", a.threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
+      ->type_name("N")
+      ->check(whole_number(1, 1024));
+  sub.add_option("--set", a.sets, "parameter override; MODEL may be * for every model that\nhas NAME; repeatable")
+      ->type_name("MODEL.NAME=VALUE")
+      ->allow_extra_args(false);
+  sub.add_option("--out", a.out, "the report's directory")->type_name("DIR")->capture_default_str();
+  sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write the report only");
+  sub.add_option("--device", a.run.device,
+                 "Vulkan device of the *_vk models, by index or name (see\n"
+                 "list devices; default: the first discrete GPU, else any)")
+      ->type_name("NAME|INDEX");
+  sub.add_flag_callback("--no-skip", [&a] { a.run.skip_inert = false; },
+                        "run every stage even where the scene makes it inert (no\n"
+                        "colliders, no wind, zero stiffness) and never let strands\n"
+                        "sleep");
+}
+
+void add_stress_options(CLI::App& sub, StressArgs& a) {
+  sub.add_option("--models", a.models, "CPU models whose whole name matches (default: all)")->type_name("REGEX");
+  sub.add_option("--base", a.opt.base, "the stable starting point: built-in scenario or scenario\nfile")
+      ->type_name("SCENARIO")
+      ->capture_default_str();
+  sub.add_option("--axes", a.opt.axes, "axes whose whole name matches (default: all)")->type_name("REGEX");
+  sub.add_option("--keep-every", a.opt.keep_every, "thin the base groom to every N-th strand, 1 to 1000000")
+      ->type_name("N")
+      ->check(whole_number(1, 1'000'000))
+      ->capture_default_str();
+  sub.add_flag_callback("--quick", [&a] { a.opt.value_stride = 2; }, "try every other value of each axis");
+  sub.add_option("--threads", a.threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
+      ->type_name("N")
+      ->check(whole_number(1, 1024));
+  sub.add_option("--out", a.out, "the report's directory")->type_name("DIR")->capture_default_str();
+  sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write stress.json only, no heatmap");
+}
+
+void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, ReproduceOptions& o) {
+  sub.add_option("TABLE", tables, "han2012, halen2007, plante2001 or all; several may be named")
+      ->type_name("NAME");
+  sub.add_option("--frames", o.frames, "cap every run at N frames (quick runs), 1 to 1000000")
+      ->type_name("N")
+      ->check(whole_number(1, 1'000'000));
+  sub.add_option("--threads", o.threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
+      ->type_name("N")
+      ->check(whole_number(1, 1024));
+  sub.add_option("--device", o.device, "Vulkan device for Han & Harada's GPU table, by index or\nname")
+      ->type_name("NAME|INDEX");
+  sub.add_option("--out", o.out, "the report's directory")->type_name("DIR")->capture_default_str();
+}
+
+// CLI11's parse errors in the project's one-line form, naming the argument and the
+// subcommand whose help lists what it takes.
+InputError argument_error(const CLI::App& top, const CLI::ParseError& e) {
+  // The application whose arguments were being read: the subcommand (there is at most
+  // one) unless an extra argument came before any.
+  const std::vector<CLI::App*> parsed = top.get_subcommands();
+  const CLI::App* sub = parsed.empty() || e.get_name() == top.get_name() ? &top : parsed.front();
+  const std::string help = sub == &top ? "hairbench --help" : "hairbench " + sub->get_name() + " --help";
+  if (dynamic_cast<const CLI::ExtrasError*>(&e) && !sub->remaining().empty()) {
+    const std::string arg = sub->remaining().front();
+    const char* what = arg.starts_with('-') ? "unknown option"
+                       : sub == &top        ? "unknown subcommand"
+                                            : "unexpected argument";
+    return InputError("arguments", arg, std::string(what) + " (see " + help + ")");
+  }
+  const std::string msg = e.what();
+  if (dynamic_cast<const CLI::ArgumentMismatch*>(&e)) {
+    // It names the option first: "--frames: ..." (a value missing at the end of the
+    // line) or "quick was given a disallowed flag override".
+    const std::string name = msg.substr(0, msg.find_first_of(": "));
+    const CLI::Option* opt = sub->get_option_no_throw(name);
+    if (!opt) opt = sub->get_option_no_throw("--" + name);
+    if (opt && opt->get_items_expected_max() == 0) return InputError("arguments", opt->get_name(), "takes no value");
+    if (opt) return InputError("arguments", opt->get_name(), "needs a value");
+  }
+  if (dynamic_cast<const CLI::RequiredError*>(&e) && sub != &top)
+    return InputError("arguments", sub->get_name(), msg + " (see " + help + ")");
+  return InputError("arguments: " + msg);
 }
 
 int run(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-    std::puts(kUsage);
-    return args.empty() ? 2 : 0;
+  CLI::App app(kDescription, "hairbench");
+  app.footer(kExitCodes);
+  app.set_version_flag("--version", std::string("hairbench ") + HAIRBENCH_GIT_SHA,
+                       "print the commit this binary was built from");
+  app.require_subcommand(0, 1);
+  // An option given twice keeps its last value; the repeatable ones (--scenario, --set)
+  // keep every value.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  // A flag takes no value (`--no-charts=false` is a mistake, not a way to turn it off).
+  app.option_defaults()->disable_flag_override();
+
+  std::string list_what;
+  CLI::App* list = app.add_subcommand("list", kListHelp);
+  list->add_option("WHAT", list_what, "what to list")->type_name("models|scenarios|devices");
+
+  CompareArgs compare_args, sweep_args;
+  CLI::App* compare = app.add_subcommand("compare", kCompareHelp);
+  add_run_options(*compare, compare_args, false);
+  CLI::App* sweep = app.add_subcommand("sweep", kSweepHelp);
+  add_run_options(*sweep, sweep_args, true);
+
+  StressArgs stress_args;
+  CLI::App* stress = app.add_subcommand("stress", kStressHelp);
+  add_stress_options(*stress, stress_args);
+
+  std::vector<std::string> tables;
+  ReproduceOptions reproduce_opt;
+  CLI::App* reproduce = app.add_subcommand("reproduce", kReproduceHelp);
+  add_reproduce_options(*reproduce, tables, reproduce_opt);
+
+  // Without arguments the usage is the answer, with the exit code of a bad command line;
+  // `hairbench help` is a documented spelling of --help.
+  if (argc < 2 || std::string_view(argv[1]) == "help") {
+    std::fputs(app.help().c_str(), stdout);
+    return argc < 2 ? 2 : 0;
   }
-  const std::string cmd = args[0];
-  args.erase(args.begin());
-  if (cmd == "compare") return cmd_compare(args);
-  if (cmd == "sweep") return cmd_sweep(args);
-  if (cmd == "list") return cmd_list(args);
-  if (cmd == "stress") return cmd_stress(args);
-  if (cmd == "reproduce") return cmd_reproduce(args);
-  throw InputError("arguments", cmd, "unknown command (see hairbench --help)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, -h, --version: printed on stdout
+    throw argument_error(app, e);
+  }
+  if (list->parsed()) return cmd_list(list_what);
+  if (compare->parsed()) return cmd_compare(compare_args);
+  if (sweep->parsed()) return cmd_sweep(sweep_args);
+  if (stress->parsed()) return cmd_stress(stress_args);
+  if (reproduce->parsed()) {
+    reproduce_opt.papers = select_papers(tables);
+    return cmd_reproduce(reproduce_opt);
+  }
+  throw InputError("arguments", "hairbench",
+                   "name a subcommand: list, compare, sweep, stress or reproduce (see hairbench --help)");
 }
 
 }  // namespace

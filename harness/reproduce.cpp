@@ -2,7 +2,6 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
-#include "harness/args.h"
 #include "harness/paper_setups.h"
 #include "harness/runner.h"
 #include "harness/stress.h"
@@ -293,8 +292,8 @@ json reproduce_han(const Ctx& c) {
       const double d = metrics::deviation(p, p1, rest.mean_strand_length);
       l.dev2 += d * d;
       for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) {
-        const double j = metrics::strand_jaggedness_raw(p.subspan(sc.groom.strand_begin(s), sc.groom.strand_size(s))) -
-                         rest.rest_jaggedness[s];
+        const std::size_t b = sc.groom.strand_begin(s), n = sc.groom.strand_size(s);
+        const double j = metrics::strand_jaggedness(p.subspan(b, n), std::span(rest.rest_kb_change).subspan(b, n));
         l.strand_peak[s] = std::max(l.strand_peak[s], j);
       }
     }
@@ -719,29 +718,16 @@ json check_json(const ReproduceCheck& c) {
           {"reason", reason}};
 }
 
-ReproduceOptions parse_reproduce_args(const std::vector<std::string>& args) {
-  ReproduceOptions o;
-  std::vector<std::string> which;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw InputError("arguments", a, "needs a value");
-      return args[++i];
-    };
-    if (a == "--frames") o.frames = parse_int(a, value(), 1, 1'000'000);
-    else if (a == "--threads") o.threads = parse_int(a, value(), 1, 1024);
-    else if (a == "--device") o.device = value();
-    else if (a == "--out") o.out = value();
-    else if (!a.empty() && a[0] == '-') throw InputError("arguments", a, "unknown option (see hairbench --help)");
-    else if (a == "all" || std::find(std::begin(kReproducePapers), std::end(kReproducePapers), a) != std::end(kReproducePapers))
-      which.push_back(a);
-    else throw InputError("arguments", "reproduce " + a, "expected han2012, halen2007, plante2001 or all");
-  }
-  if (which.empty()) throw InputError("arguments", "reproduce", "name a table: han2012, halen2007, plante2001 or all");
+std::vector<std::string> select_papers(const std::vector<std::string>& names) {
+  auto named = [&](const std::string& p) { return std::find(names.begin(), names.end(), p) != names.end(); };
+  for (const std::string& n : names)
+    if (n != "all" && std::ranges::find(kReproducePapers, n) == std::end(kReproducePapers))
+      throw InputError("arguments", "reproduce " + n, "expected han2012, halen2007, plante2001 or all");
+  if (names.empty()) throw InputError("arguments", "reproduce", "name a table: han2012, halen2007, plante2001 or all");
+  std::vector<std::string> papers;
   for (const char* p : kReproducePapers)
-    if (std::find(which.begin(), which.end(), p) != which.end() || std::find(which.begin(), which.end(), "all") != which.end())
-      o.papers.emplace_back(p);
-  return o;
+    if (named(p) || named("all")) papers.emplace_back(p);
+  return papers;
 }
 
 json run_reproduce(const ReproduceOptions& opt, const std::function<void(const std::string&)>& log) {
@@ -860,8 +846,7 @@ std::string reproduce_html(const json& r) {
   return o.str();
 }
 
-int cmd_reproduce(const std::vector<std::string>& args) {
-  const ReproduceOptions opt = parse_reproduce_args(args);
+int cmd_reproduce(const ReproduceOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   const json report = run_reproduce(opt, [&](const std::string& line) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

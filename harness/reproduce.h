@@ -1,4 +1,4 @@
-// `hairbench reproduce` (issue 9): runs the configurations behind the papers' published
+// `hairbench reproduce`: runs the configurations behind the papers' published
 // tables (reports/published/*.json) on this machine and writes a report with, per row,
 // the published value, the measured one, and the comparison that survives a change of
 // hardware (ratios between methods, growth with size, time shares), each with a verdict.
@@ -25,9 +25,9 @@ struct ReproduceOptions {
   std::filesystem::path out = "reports/out/reproduce";
 };
 
-// `reproduce han2012|halen2007|plante2001|all [--frames N] [--threads N] [--device D]
-// [--out DIR]`; throws InputError naming the argument.
-ReproduceOptions parse_reproduce_args(const std::vector<std::string>& args);
+// The tables named on the command line (each of kReproducePapers or "all") as
+// ReproduceOptions::papers, in kReproducePapers order; throws InputError naming a bad one.
+std::vector<std::string> select_papers(const std::vector<std::string>& names);
 
 // One comparison or claim: it holds when `measured` is finite and within [min, max]
 // (either bound may be open). The verdict is computed from these fields only, so a
@@ -50,7 +50,7 @@ nlohmann::json run_reproduce(const ReproduceOptions& opt, const std::function<vo
 std::string reproduce_markdown(const nlohmann::json& report);
 std::string reproduce_html(const nlohmann::json& report);
 
-// The command: parse, run, write OUT/reproduce.{json,md,html}, print the verdict table.
-int cmd_reproduce(const std::vector<std::string>& args);
+// The command: run, write OUT/reproduce.{json,md,html}, print the verdict table.
+int cmd_reproduce(const ReproduceOptions& opt);
 
 }  // namespace hairbench

@@ -3,8 +3,10 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/follow_adapter.h"
+#include "harness/probe.h"
 #include "harness/roofline.h"
 #include "reports/metrics.h"
+#include "reports/verdict.h"
 #include "scenarios/phases.h"
 
 #include <algorithm>
@@ -138,17 +140,6 @@ nlohmann::json params_json(const ParamSet& p, const Groom& g) {
   return j;
 }
 
-struct Lane {
-  const ModelInfo* info;
-  std::unique_ptr<HairModel> model;
-  RunRecord record;
-  bool reported;
-  bool running = true;
-  // With RunOptions::energy_check: last frame's positions and the growth check.
-  std::vector<Vec4f> prev;
-  std::optional<metrics::EnergyGrowthCheck> energy;
-};
-
 bool same_params(const ParamSet& a, const ParamSet& b) { return a.base() == b.base() && a.regions() == b.regions(); }
 
 std::vector<ParamOverride> concat(std::vector<ParamOverride> a, const std::vector<ParamOverride>& b) {
@@ -169,19 +160,59 @@ void take_snapshot(const Groom& g, std::span<const std::uint32_t> strands, std::
   }
 }
 
-// Kinetic energy per unit mass of the hair relative to the head between two frames:
-// mean over vertices of |p - H H_prev^-1 p_prev|^2 / (2 dt^2). Hair carried rigidly by
-// the head scores 0, so a walk's steady translation is not "violent"; a whip is.
-double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, const Affine3f& head,
-                               const Affine3f& head_prev, double dt) {
-  const Affine3f carry = head * head_prev.inverse();
-  double sum = 0.0;
-  for (std::size_t v = 0; v < p.size(); ++v) {
-    const Vec3f d = p[v].head<3>() - carry * Vec3f(prev[v].head<3>());
-    sum += static_cast<double>(d.squaredNorm());
+// One model stepping through the scenario, with its record and its detectors.
+struct Lane {
+  const ModelInfo* info;
+  std::unique_ptr<HairModel> model;
+  RunRecord record;
+  bool reported;
+  bool running = true;
+  std::vector<Vec4f> prev;  // positions at the end of the previous frame
+  metrics::EnergyGrowthCheck energy;
+  verdict::StretchTracker stretch;
+  verdict::SettleCheck settle;
+  verdict::Probe probe;
+  double kinetic = 0.0;  // this frame's kinetic energy relative to the head
+};
+
+// The lockstep run of one scenario, step by step: make the lanes (the reference first),
+// then per frame step every lane, stop the lanes that diverged, measure the others and
+// take the snapshots; at the end decide each lane's verdict.
+class LockstepRun {
+ public:
+  LockstepRun(const Scenario& sc, const RunOptions& opt, ThreadPool& pool)
+      : sc_(sc), opt_(opt), pool_(pool), rest_(sc.groom, sc.follow ? sc.guides.strand_count() : sc.groom.strand_count()),
+        snap_strands_(snapshot_strands(sc.groom)) {
+    // Follow hairs are their guide plus a rigid offset, with unconstrained edges: their
+    // stretch belongs to the follow layer, so the stretched verdict reads the guides'.
+    if (sc.follow) guides_.emplace(sc.guides);
   }
-  return p.empty() ? 0.0 : sum / (2.0 * dt * dt * static_cast<double>(p.size()));
-}
+
+  std::vector<RunRecord> run();
+
+ private:
+  void make_lanes();
+  void add_lane(const ModelInfo* info, const ParamSet& params, bool reported);
+  void step_lanes(const FrameInput& in, bool driven);
+  void stop_diverged(const FrameInput& in, int f, bool driven);
+  void measure(const FrameInput& in);
+  void snapshot(const FrameInput& in, int f, int frames);
+  void record_scenario(int frames) const;
+
+  const Scenario& sc_;
+  const RunOptions& opt_;
+  ThreadPool& pool_;
+  const metrics::RestInfo rest_;
+  std::optional<metrics::RestInfo> guides_;  // the simulated strands, where follow hairs are rebuilt
+  const std::vector<std::uint32_t> snap_strands_;
+  std::string reference_;
+  std::map<std::string, double> ref_overrides_;
+  std::vector<Lane> lanes_;
+  std::vector<Vec4f> spheres_;
+  StageTimes times_;
+  double max_violence_ = -1.0;
+  ScenarioRecord::SnapshotFrame violent_frame_, final_frame_;
+};
 
 }  // namespace
 
@@ -221,223 +252,238 @@ std::vector<std::uint32_t> snapshot_strands(const Groom& groom) {
   return out;
 }
 
-std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, ThreadPool& pool) {
-  const std::string reference = opt.reference.empty() ? sc.reference : opt.reference;
-  const ModelInfo* ref_info = find_model(reference);
-  if (!ref_info) throw InputError(sc.source.string(), "reference", "unknown model '" + reference + "'");
-  std::map<std::string, double> ref_overrides;
-  for (const ParamOverride& o : opt.reference_overrides) ref_overrides[o.name] = o.value;
+void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool reported) {
+  // The probe first: a model whose rest state is unstable must not sleep, or sleeping
+  // would freeze the growth it is about to show (and change its metrics).
+  verdict::Probe probe;
+  if (opt_.probe) probe = perturbation_probe(*info, sc_, params, pool_, opt_.device);
+  const bool skip = opt_.skip_inert && !(probe.run && probe.grows);
+  Lane lane{info, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
+            metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe};
+  RunRecord& r = lane.record;
+  r.scenario = sc_.name;
+  r.model = std::string(info->name);
+  const Backend backend = lane.model->backend();
+  r.backend = backend.name;
+  r.device = backend.device;
+  if (backend.name == "cpu") {
+    r.state_bytes = lane.model->state_bytes();
+    r.stream_ms = stream_seconds(r.state_bytes, pool_) * 1e3;
+  }
+  r.strands = sc_.groom.strand_count();
+  r.vertices = sc_.groom.vertex_count();
+  r.dt = sc_.dt;
+  r.settle_from = sc_.settle_from;
+  r.params = params_json(params, sc_.groom);
+  r.reference = reference_;
+  r.reference_overrides = ref_overrides_;
+  if (reported) r.knob = opt_.knob;
+  r.snapshots = {{"most_violent", -1, {}}, {"final", -1, {}}};
+  // The hair at rest under the first frame's starting head transform.
+  lane.prev = sc_.groom.positions;
+  const Affine3f h0 = sc_.head.at(0.0);
+  for (Vec4f& p : lane.prev) p.head<3>() = h0 * Vec3f(p.head<3>());
+  lanes_.push_back(std::move(lane));
+}
 
-  // The reference runs once per scenario: it is lane 0, and it is also the reported run
-  // of its model when that run's parameters are the same.
-  std::vector<Lane> lanes;
-  auto add_lane = [&](const ModelInfo* info, const ParamSet& params, bool reported) {
-    Lane lane{info, make_model(*info, sc, params, pool, opt.device, opt.skip_inert), {}, reported, true, {}, {}};
-    RunRecord& r = lane.record;
-    r.scenario = sc.name;
-    r.model = std::string(info->name);
-    const Backend backend = lane.model->backend();
-    r.backend = backend.name;
-    r.device = backend.device;
-    if (backend.name == "cpu") {
-      r.state_bytes = lane.model->state_bytes();
-      r.stream_ms = stream_seconds(r.state_bytes, pool) * 1e3;
-    }
-    r.strands = sc.groom.strand_count();
-    r.vertices = sc.groom.vertex_count();
-    r.dt = sc.dt;
-    r.settle_from = sc.settle_from;
-    r.params = params_json(params, sc.groom);
-    r.reference = reference;
-    r.reference_overrides = ref_overrides;
-    if (reported) r.knob = opt.knob;
-    r.snapshots = {{"most_violent", -1, {}}, {"final", -1, {}}};
-    if (opt.energy_check) {
-      const auto p = lane.model->positions();
-      lane.prev.assign(p.begin(), p.end());
-      lane.energy.emplace(mean_strand_length(sc.groom), sc.gravity.norm());
-    }
-    lanes.push_back(std::move(lane));
-  };
-  const ParamSet ref_params = resolve_params(*ref_info, sc, concat(opt.overrides, opt.reference_overrides));
-  add_lane(ref_info, ref_params, false);
-  for (const std::string& m : opt.models) {
+// The reference runs once per scenario: it is lane 0, and it is also the reported run of
+// its model when that run's parameters are the same.
+void LockstepRun::make_lanes() {
+  reference_ = opt_.reference.empty() ? sc_.reference : opt_.reference;
+  const ModelInfo* ref_info = find_model(reference_);
+  if (!ref_info) throw InputError(sc_.source.string(), "reference", "unknown model '" + reference_ + "'");
+  for (const ParamOverride& o : opt_.reference_overrides) ref_overrides_[o.name] = o.value;
+  const ParamSet ref_params = resolve_params(*ref_info, sc_, concat(opt_.overrides, opt_.reference_overrides));
+  // Every model's parameters are checked before any lane is made (and probed).
+  std::vector<std::pair<const ModelInfo*, ParamSet>> reported;
+  for (const std::string& m : opt_.models) {
     const ModelInfo* info = find_model(m);
     if (!info) throw InputError("--models", m, "unknown model");
-    const ParamSet params = resolve_params(*info, sc, concat(opt.overrides, opt.model_overrides));
+    reported.emplace_back(info, resolve_params(*info, sc_, concat(opt_.overrides, opt_.model_overrides)));
+  }
+  add_lane(ref_info, ref_params, false);
+  for (const auto& [info, params] : reported) {
     if (info == ref_info && same_params(params, ref_params)) {
-      lanes[0].reported = true;
-      lanes[0].record.knob = opt.knob;
+      lanes_[0].reported = true;
+      lanes_[0].record.knob = opt_.knob;
       continue;
     }
     add_lane(info, params, true);
   }
+}
 
-  const int frames = opt.frames > 0 ? opt.frames : sc.frames;
-  for (Lane& l : lanes) l.record.frames = frames;
-  const metrics::RestInfo rest(sc.groom, sc.follow ? sc.guides.strand_count() : sc.groom.strand_count());
-  const std::vector<std::uint32_t> snap_strands = snapshot_strands(sc.groom);
-  StageTimes times;
-  std::vector<Vec4f> spheres;
-  // The reference's positions at the end of the previous frame (at rest under the first
-  // frame's starting head transform before frame 0), for the violence criterion.
-  std::vector<Vec4f> ref_prev(sc.groom.positions);
-  {
-    const Affine3f h0 = sc.head.at(0.0);
-    for (Vec4f& p : ref_prev) p.head<3>() = h0 * Vec3f(p.head<3>());
-  }
-  double max_violence = -1.0;
-  ScenarioRecord::SnapshotFrame violent_frame, final_frame;
-
-  for (int f = 0; f < frames; ++f) {
-    const FrameInput in = frame_input(sc, f);
-    spheres.clear();
-    for (const Sphere& c : sc.colliders) {
-      const Vec3f center = collider_center(c, in.head);
-      spheres.emplace_back(center.x(), center.y(), center.z(), c.radius);
+// Steps every running lane, timing the step. A frame counts as worked unless the model
+// skipped every stage (all its strands slept) while nothing drove the hair.
+void LockstepRun::step_lanes(const FrameInput& in, bool driven) {
+  for (Lane& l : lanes_) {
+    if (!l.running) continue;
+    times_.clear();
+    const auto start = std::chrono::steady_clock::now();
+    l.model->step(in, times_);
+    const auto end = std::chrono::steady_clock::now();
+    l.record.step_ms.push_back(std::chrono::duration<double, std::milli>(end - start).count());
+    if (const auto gpu = l.model->last_gpu_ms()) l.record.gpu_ms.push_back(*gpu);
+    bool ran = times_.entries().empty();
+    for (const auto& e : times_.entries()) {
+      l.record.stage_ms_total[std::string(e.name)] += e.ms;
+      if (e.skipped) ++l.record.stage_skipped_steps[std::string(e.name)];
+      ran |= !e.skipped;
     }
+    l.record.worked.push_back(driven || ran);
+  }
+}
 
-    for (Lane& l : lanes) {
+// Divergence first, so that a reference that diverged this frame is not used as one. One
+// task per lane on the pool, each value computed whole by one thread, so no number
+// depends on the thread count: the blow-up tests, the mechanical energy's growth with
+// nothing driving the hair, and the kinetic energy relative to the head for the settle
+// check and the snapshots.
+void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
+  std::vector<std::string> why(lanes_.size());
+  pool_.parallel_for(lanes_.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      Lane& l = lanes_[i];
       if (!l.running) continue;
-      times.clear();
-      const auto start = std::chrono::steady_clock::now();
-      l.model->step(in, times);
-      const auto end = std::chrono::steady_clock::now();
-      l.record.step_ms.push_back(std::chrono::duration<double, std::milli>(end - start).count());
-      if (const auto gpu = l.model->last_gpu_ms()) l.record.gpu_ms.push_back(*gpu);
-      for (const auto& e : times.entries()) {
-        l.record.stage_ms_total[std::string(e.name)] += e.ms;
-        if (e.skipped) ++l.record.stage_skipped_steps[std::string(e.name)];
+      const auto p = l.model->positions();
+      why[i] = metrics::blowup_reason(rest_, p, in.head.translation());
+      if (why[i].empty()) why[i] = l.energy.add(metrics::mechanical_energy(p, l.prev, sc_.dt, sc_.gravity), driven);
+      l.kinetic = verdict::relative_kinetic_energy(p, l.prev, in.head, in.head_prev, sc_.dt);
+      l.settle.add(in.t, l.kinetic, driven, sc_.settle_from);
+      l.prev.assign(p.begin(), p.end());
+    }
+  });
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    Lane& l = lanes_[i];
+    if (!l.running || why[i].empty()) continue;
+    RunRecord& r = l.record;
+    r.failure = RunRecord::Failure{f, in.t, why[i]};
+    l.running = false;
+    // Keep the series aligned with the frames that ran: null for the one that diverged.
+    r.t.push_back(in.t);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (auto* v : {&r.deviation, &r.jaggedness, &r.length_rms, &r.length_max, &r.rest_shape_error, &r.penetration})
+      v->push_back(nan);
+  }
+}
+
+// The per-frame metrics cost as much as a fast model's step, so they run on the pool:
+// one task per lane and metric.
+void LockstepRun::measure(const FrameInput& in) {
+  const bool ref_ok = lanes_[0].running;
+  enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFrameMetrics };
+  std::vector<std::array<double, kFrameMetrics>> values(lanes_.size());
+  std::vector<metrics::LengthError> length(lanes_.size()), guide_length(lanes_.size());
+  pool_.parallel_for(lanes_.size() * kFrameMetrics, [&](std::size_t b, std::size_t e) {
+    for (std::size_t task = b; task < e; ++task) {
+      const std::size_t i = task / kFrameMetrics;
+      if (!lanes_[i].running) continue;
+      const auto p = lanes_[i].model->positions();
+      auto& v = values[i];
+      switch (static_cast<FrameMetric>(task % kFrameMetrics)) {
+        case kDeviation:
+          v[kDeviation] = ref_ok ? metrics::deviation(p, lanes_[0].model->positions(), rest_.mean_strand_length)
+                                 : std::numeric_limits<double>::quiet_NaN();
+          break;
+        case kJaggedness: v[kJaggedness] = metrics::jaggedness(rest_, p); break;
+        case kLength:
+          length[i] = metrics::length_error(rest_, p);
+          guide_length[i] =
+              guides_ ? metrics::length_error(*guides_, p.first(sc_.guides.vertex_count())) : length[i];
+          break;
+        case kRestShape: v[kRestShape] = metrics::rest_shape_error(rest_, p, in.head); break;
+        case kPenetration: v[kPenetration] = metrics::penetration(p, spheres_); break;
+        case kFrameMetrics: break;
       }
     }
+  });
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    Lane& l = lanes_[i];
+    if (!l.running) continue;
+    RunRecord& r = l.record;
+    const auto& v = values[i];
+    r.t.push_back(in.t);
+    r.deviation.push_back(v[kDeviation]);
+    r.jaggedness.push_back(v[kJaggedness]);
+    r.length_rms.push_back(length[i].rms);
+    r.length_max.push_back(length[i].max);
+    r.rest_shape_error.push_back(v[kRestShape]);
+    r.penetration.push_back(v[kPenetration]);
+    l.stretch.add(in.frame, guide_length[i]);
+  }
+}
 
-    // Stability first, so that a reference failing this frame is not used as one.
+// Snapshots: the most violent frame is the first one where the reference's kinetic
+// energy relative to the head is highest; a new one replaces the previous one in every
+// lane (a lane that has stopped has none there). The final frame is the last one each
+// lane ran.
+void LockstepRun::snapshot(const FrameInput& in, int f, int frames) {
+  if (lanes_[0].running && lanes_[0].kinetic > max_violence_) {
+    max_violence_ = lanes_[0].kinetic;
+    violent_frame_ = {"most_violent", f, in.t, max_violence_, in.head};
+    for (Lane& l : lanes_) {
+      if (l.running) take_snapshot(sc_.groom, snap_strands_, l.model->positions(), l.record.snapshots[0], f);
+      else l.record.snapshots[0] = {"most_violent", -1, {}};
+    }
+  }
+  if (f == frames - 1) {
+    final_frame_ = {"final", f, in.t, 0.0, in.head};
+    for (Lane& l : lanes_)
+      if (l.running) take_snapshot(sc_.groom, snap_strands_, l.model->positions(), l.record.snapshots[1], f);
+  }
+}
+
+void LockstepRun::record_scenario(int frames) const {
+  ScenarioRecord& out = *opt_.scenario_record;
+  out.name = sc_.name;
+  out.frames = frames;
+  out.dt = sc_.dt;
+  out.mean_strand_length = rest_.mean_strand_length;
+  out.head_radius = sc_.groom.head_radius;
+  out.phases.clear();
+  for (const Phase& p : scenario_phases(sc_, frames * sc_.dt)) out.phases.push_back({p.start, p.end, p.kind, p.label});
+  out.snapshot_strands = snap_strands_;
+  out.snapshot_frames.clear();
+  for (const auto& fr : {violent_frame_, final_frame_})
+    if (fr.frame >= 0) out.snapshot_frames.push_back(fr);
+  out.reference = reference_;
+  out.reference_snapshots = lanes_[0].record.snapshots;
+}
+
+std::vector<RunRecord> LockstepRun::run() {
+  make_lanes();
+  const int frames = opt_.frames > 0 ? opt_.frames : sc_.frames;
+  for (Lane& l : lanes_) l.record.frames = frames;
+  for (int f = 0; f < frames; ++f) {
+    const FrameInput in = frame_input(sc_, f);
     const bool driven = in.head.matrix() != in.head_prev.matrix() || in.wind.active();
-    // The metrics cost as much as a fast model's step, so they run on the pool: one task
-    // per lane (and below, per lane and metric), each value computed whole by one thread,
-    // so no number depends on the thread count.
-    std::vector<std::string> blowup(lanes.size());
-    pool.parallel_for(lanes.size(), [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        Lane& l = lanes[i];
-        if (!l.running) continue;
-        std::string why = metrics::blowup_reason(rest, l.model->positions(), in.head.translation());
-        if (why.empty() && l.energy) {
-          const auto p = l.model->positions();
-          why = l.energy->add(metrics::mechanical_energy(p, l.prev, sc.dt, sc.gravity), driven);
-          l.prev.assign(p.begin(), p.end());
-        }
-        blowup[i] = std::move(why);
-      }
-    });
-    for (std::size_t i = 0; i < lanes.size(); ++i) {
-      Lane& l = lanes[i];
-      const std::string& why = blowup[i];
-      if (!l.running || why.empty()) continue;
-      RunRecord& r = l.record;
-      r.failure = RunRecord::Failure{f, in.t, why};
-      l.running = false;
-      // Keep the series aligned with the frames that ran: null for the failed one.
-      r.t.push_back(in.t);
-      const double nan = std::numeric_limits<double>::quiet_NaN();
-      for (auto* v : {&r.deviation, &r.jaggedness, &r.length_rms, &r.length_max, &r.rest_shape_error,
-                      &r.penetration})
-        v->push_back(nan);
+    spheres_.clear();
+    for (const Sphere& c : sc_.colliders) {
+      const Vec3f center = collider_center(c, in.head);
+      spheres_.emplace_back(center.x(), center.y(), center.z(), c.radius);
     }
-    const bool ref_ok = lanes[0].running;
-    enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFrameMetrics };
-    std::vector<std::array<double, kFrameMetrics + 1>> values(lanes.size());  // length: rms, max
-    // One more task: the reference's violence for the snapshots (below), which would
-    // otherwise run alone on this thread while the pool waits.
-    const std::size_t metric_tasks = lanes.size() * kFrameMetrics;
-    double violence = 0.0;
-    pool.parallel_for(metric_tasks + 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t task = b; task < e; ++task) {
-        if (task == metric_tasks) {
-          if (ref_ok)
-            violence = relative_kinetic_energy(lanes[0].model->positions(), ref_prev, in.head, in.head_prev, sc.dt);
-          continue;
-        }
-        const std::size_t i = task / kFrameMetrics;
-        if (!lanes[i].running) continue;
-        const auto p = lanes[i].model->positions();
-        auto& v = values[i];
-        switch (static_cast<FrameMetric>(task % kFrameMetrics)) {
-          case kDeviation:
-            v[kDeviation] = ref_ok ? metrics::deviation(p, lanes[0].model->positions(), rest.mean_strand_length)
-                                   : std::numeric_limits<double>::quiet_NaN();
-            break;
-          case kJaggedness: v[kJaggedness] = metrics::jaggedness(rest, p); break;
-          case kLength: {
-            const metrics::LengthError le = metrics::length_error(rest, p);
-            v[kLength] = le.rms;
-            v[kFrameMetrics] = le.max;
-            break;
-          }
-          case kRestShape: v[kRestShape] = metrics::rest_shape_error(rest, p, in.head); break;
-          case kPenetration: v[kPenetration] = metrics::penetration(p, spheres); break;
-          case kFrameMetrics: break;
-        }
-      }
-    });
-    for (std::size_t i = 0; i < lanes.size(); ++i) {
-      if (!lanes[i].running) continue;
-      RunRecord& r = lanes[i].record;
-      const auto& v = values[i];
-      r.t.push_back(in.t);
-      r.deviation.push_back(v[kDeviation]);
-      r.jaggedness.push_back(v[kJaggedness]);
-      r.length_rms.push_back(v[kLength]);
-      r.length_max.push_back(v[kFrameMetrics]);
-      r.rest_shape_error.push_back(v[kRestShape]);
-      r.penetration.push_back(v[kPenetration]);
-    }
-
-    // Snapshots: a new most violent frame replaces the previous one in every lane (a lane
-    // that has stopped has none there); the final frame is the last one each lane ran.
-    if (ref_ok) {
-      const auto ref_p = lanes[0].model->positions();
-      std::copy(ref_p.begin(), ref_p.end(), ref_prev.begin());
-      if (violence > max_violence) {
-        max_violence = violence;
-        violent_frame = {"most_violent", f, in.t, violence, in.head};
-        for (Lane& l : lanes) {
-          if (l.running) take_snapshot(sc.groom, snap_strands, l.model->positions(), l.record.snapshots[0], f);
-          else l.record.snapshots[0] = {"most_violent", -1, {}};
-        }
-      }
-    }
-    if (f == frames - 1) {
-      final_frame = {"final", f, in.t, 0.0, in.head};
-      for (Lane& l : lanes)
-        if (l.running) take_snapshot(sc.groom, snap_strands, l.model->positions(), l.record.snapshots[1], f);
-    }
-    if (opt.on_frame) opt.on_frame(f + 1, frames);
+    step_lanes(in, driven);
+    stop_diverged(in, f, driven);
+    measure(in);
+    snapshot(in, f, frames);
+    if (opt_.on_frame) opt_.on_frame(f + 1, frames);
   }
-
-  if (opt.scenario_record) {
-    ScenarioRecord& out = *opt.scenario_record;
-    out.name = sc.name;
-    out.frames = frames;
-    out.dt = sc.dt;
-    out.mean_strand_length = rest.mean_strand_length;
-    out.head_radius = sc.groom.head_radius;
-    out.phases.clear();
-    for (const Phase& p : scenario_phases(sc, frames * sc.dt)) out.phases.push_back({p.start, p.end, p.kind, p.label});
-    out.snapshot_strands = snap_strands;
-    out.snapshot_frames.clear();
-    for (const auto& fr : {violent_frame, final_frame})
-      if (fr.frame >= 0) out.snapshot_frames.push_back(fr);
-    out.reference = reference;
-    out.reference_snapshots = lanes[0].record.snapshots;
-  }
+  if (opt_.scenario_record) record_scenario(frames);
 
   std::vector<RunRecord> out;
-  for (Lane& l : lanes) {
-    l.record.state_hash = metrics::state_hash(l.model->positions());
-    if (l.reported) out.push_back(std::move(l.record));
+  for (Lane& l : lanes_) {
+    RunRecord& r = l.record;
+    r.state_hash = metrics::state_hash(l.model->positions());
+    std::optional<std::pair<int, double>> stop;
+    if (r.failure) stop = std::make_pair(r.failure->frame, r.failure->t);
+    r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", l.stretch.result(), l.settle.result(),
+                                l.probe, sc_.dt);
+    if (l.reported) out.push_back(std::move(r));
   }
   return out;
+}
+
+std::vector<RunRecord> run_scenario(const Scenario& sc, const RunOptions& opt, ThreadPool& pool) {
+  return LockstepRun(sc, opt, pool).run();
 }
 
 }  // namespace hairbench

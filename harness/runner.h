@@ -1,6 +1,6 @@
 // The lockstep runner: every selected model steps through the same scenario frame by
 // frame with the identical FrameInput; metrics are taken after each step against the
-// reference model's positions of the same frame (DESIGN.md, "Data flow").
+// reference model's positions of the same frame (docs/architecture.md).
 #pragma once
 
 #include "core/params.h"
@@ -53,9 +53,10 @@ struct RunOptions {
   // the reference's snapshots.
   ScenarioRecord* scenario_record = nullptr;
   std::string device;  // GPU models' --device (empty: the default device)
-  // Stress runs: a model whose mechanical energy keeps growing while the head
-  // is still and no wind blows also fails (metrics::EnergyGrowthCheck).
-  bool energy_check = false;
+  // Each lane's perturbation probe at rest (harness/probe.h), for the `unstable`
+  // verdict; a model whose probe grows never sleeps. Off only where a test or benchmark
+  // needs bare steps.
+  bool probe = true;
   // false (--no-skip): models run every stage even where it is inert and no strand
   // sleeps (ModelContext::skip_inert), to show what skipping saves and that it changes
   // nothing else.
@@ -78,8 +79,9 @@ std::vector<ParamOverride> converged_reference_overrides();
 // kMaxSnapshotStrands of them.
 std::vector<std::uint32_t> snapshot_strands(const Groom& groom);
 
-// Runs one scenario; a model that becomes unstable stops there (recorded in its
-// RunRecord) and the others go on. Every run records the scenario's two snapshot frames:
+// Runs one scenario; a model that diverges stops there (RunRecord::failure) and the
+// others go on; every run ends with its verdict (reports/verdict.h). Every run records
+// the scenario's two snapshot frames:
 // the most violent one, where the reference's kinetic energy per unit mass relative to
 // the head, mean |p(t) - H(t) H(t-dt)^-1 p(t-dt)|^2 / (2 dt^2), is highest (the first such
 // frame), and the final one. Throws InputError for bad parameters.

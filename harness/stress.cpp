@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/runner.h"
+#include "reports/verdict.h"
 #include "models/registry.h"
 #include "scenarios/groom_gen.h"
 
@@ -97,7 +98,7 @@ std::vector<Axis> axes_for(const ModelInfo& model) {
        [](Scenario& sc, auto&, double v) { regenerate_groom(sc, 16, v); }},
   };
   // Parameter extremes: every stiffness at 0 and 1, every iteration count from 1 to 64,
-  // damping at 0 and 1 (issue 8), each within what the model accepts.
+  // damping at 0 and 1, each within what the model accepts.
   const std::string name(model.name);
   for (const ParamSpec& p : model.params) {
     const std::string pn(p.name);
@@ -112,7 +113,7 @@ std::vector<Axis> axes_for(const ModelInfo& model) {
   return axes;
 }
 
-// --- Degenerate grooms (issue 8): each runs stably or is refused at load. ---
+// --- Degenerate grooms: each runs (never diverges) or is refused at load. ---
 
 struct Degenerate {
   std::string name;
@@ -179,20 +180,25 @@ std::vector<Degenerate> degenerate_grooms(float r) {
   return out;
 }
 
-// Runs `model` alone on sc with the energy check; "" if it stayed stable.
-std::string run_one(const Scenario& sc, const std::string& model, const std::vector<ParamOverride>& overrides,
-                    ThreadPool& pool) {
+// Runs `model` alone on sc: its verdict class and why, ok with "" when it held.
+// Any class but ok fails a stress value: a stretched strand is as much a limit of the
+// configuration as a diverged one.
+std::pair<verdict::Status, std::string> run_one(const Scenario& sc, const std::string& model,
+                                                const std::vector<ParamOverride>& overrides, ThreadPool& pool) {
   RunOptions opt;
   opt.models = {model};
   opt.reference = model;
   opt.overrides = overrides;
-  opt.energy_check = true;
   const std::vector<RunRecord> runs = run_scenario(sc, opt, pool);
-  const RunRecord& r = runs.front();
-  if (!r.failure) return {};
-  char at[48];
-  std::snprintf(at, sizeof at, " (t = %.3g s)", r.failure->t);
-  return r.failure->reason + at;
+  const verdict::Verdict& v = runs.front().verdict;
+  if (v.status == verdict::Status::ok) return {v.status, {}};
+  std::string why = std::string(verdict::status_name(v.status)) + ": " + v.reason;
+  if (v.frame >= 0) {
+    char at[48];
+    std::snprintf(at, sizeof at, " (t = %.3g s)", v.t);
+    why += at;
+  }
+  return {v.status, why};
 }
 
 }  // namespace
@@ -252,7 +258,7 @@ StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::f
       p.axis.apply(sc, overrides, v);
       StressCell cell{v, true, {}};
       try {
-        cell.reason = run_one(sc, p.model, overrides, pool);
+        cell.reason = run_one(sc, p.model, overrides, pool).second;
       } catch (const InputError& e) {  // the model refuses this configuration
         cell.reason = std::string("refused: ") + e.what();
       }
@@ -280,8 +286,9 @@ StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::f
       if (!d.colliders.empty()) sc.colliders = d.colliders;
       try {
         validate_groom(sc.groom, "stress: degenerate groom '" + d.name + "'");
-        dr.reason = run_one(sc, m, {}, pool);
-        if (!dr.reason.empty()) dr.status = "unstable";
+        const auto [status, why] = run_one(sc, m, {}, pool);
+        dr.status = std::string(verdict::status_name(status));
+        dr.reason = why;
       } catch (const InputError& e) {
         dr.status = "refused";
         dr.reason = e.what();
@@ -322,8 +329,10 @@ nlohmann::json stress_json(const StressResult& r) {
   return {{"base", r.base},
           {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
           {"failure_criteria",
-           "NaN/Inf; edge length error > 50%; vertex farther than 10 mean strand lengths from the head; "
-           "mechanical energy rising by > 5% g L-bar per 10-frame window for 60 frames with the head still"},
+           "any verdict but ok (docs/verdicts.md): diverged (NaN/Inf; a vertex farther than 10 mean strand "
+           "lengths from the head; mechanical energy rising by > 5% g L-bar per 10-frame window for 60 frames with "
+           "the head still), unstable (a perturbation at rest growing faster than 1/s, or motion not decaying with "
+           "the head still), stretched (an edge more than 50% of its strand's median rest edge off its rest length)"},
           {"axes", axes},
           {"degenerate", degenerate}};
 }

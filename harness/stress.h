@@ -1,4 +1,4 @@
-// `hairbench stress` (issue 8): where does each model break? Escalates one axis at a
+// `hairbench stress`: where does each model break? Escalates one axis at a
 // time from a stable base scenario and runs degenerate grooms; failures are results.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Every model by name (DESIGN.md: han_m1 ... plante_wisp; GPU variants end in _vk).
+// Every model by name (han_m1 ... plante_wisp; GPU variants end in _vk; docs/architecture.md).
 #pragma once
 
 #include "core/hair_model.h"

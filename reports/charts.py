@@ -1,18 +1,29 @@
 #!/usr/bin/env python3
 """Charts, a Markdown summary and a self-contained HTML page from a hairbench report.
 
-usage: charts.py REPORT.json [--out-dir DIR]
+usage: charts.py REPORT.json [--out-dir DIR] [--svg]
 
 Writes next to the report (or into DIR), STEM being the report's file name without .json:
-  STEM_time_vs_error.png/.svg   median step time against deviation (log-log), one line per
-                                model through its knob values, the Pareto front marked
-  STEM_timeseries.png/.svg      deviation and jaggedness over time, script phases shaded
-  STEM_stages.png/.svg          time per solver stage, stacked, per run
-  STEM_strands_SCENARIO.png/.svg  the most violent and the final frame of every run, strands
+  STEM_time_vs_error.png        median step time against deviation (log-log), one line per
+                                model through its knob values, the Pareto front marked; a run
+                                asleep through the scenario (a step faster than streaming its
+                                state once) is drawn on the time axis's floor, marked "asleep"
+  STEM_timeseries.png           deviation and jaggedness over time, script phases shaded
+  STEM_stages.png               time per solver stage, stacked, per run, one colour per stage
+                                name in the report; stages a run skipped are listed in the legend
+  STEM_strands_SCENARIO.png     the most violent and the final frame of every run, strands
                                 coloured by per-vertex deviation from the reference
   STEM_summary.md               the summary tables
-  STEM.html                     tables and every chart, images inlined: one file to open
+  STEM.html                     first an overview (a table of runs by scenarios: verdict, step
+                                time relative to the reference model, deviation, jaggedness,
+                                coloured by deviation), then the time-vs-error chart, then the
+                                per-scenario tables and every other chart; PNGs inlined: one file
   STEM_charts.json              manifest of what was drawn (files, series, Pareto points)
+
+PNGs are written with a 256-colour palette (a few hundred kilobytes for a default compare's
+pictures). --svg (or HAIRBENCH_SVG=1 in the environment, for the hairbench CLI) also writes
+every chart as SVG, the strand lines rasterized inside it. Reads schema_version 1 (snapshot
+strands as coordinate lists) and 2 (encoded strands, see decode_strand).
 
 Needs Python 3 with matplotlib (Debian: python3-matplotlib). Exit codes: 0 done; 2 the
 report cannot be read; 3 matplotlib cannot be imported (the hairbench CLI relies on it).
@@ -21,26 +32,38 @@ report cannot be read; 3 matplotlib cannot be imported (the hairbench CLI relies
 import argparse
 import base64
 import html
+import io
 import json
 import math
 import os
 import sys
+import textwrap
 
 try:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.colors
     import matplotlib.ticker
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Circle, Patch
+    from PIL import Image  # matplotlib's own PNG dependency
 except ImportError as e:  # the CLI turns exit 3 into "install python3-matplotlib"
     print(f"charts.py: {sys.executable} cannot import matplotlib ({e}); install Debian's python3-matplotlib "
           f"and run it with /usr/bin/python3", file=sys.stderr)
     sys.exit(3)
 
+# Runs whose verdict is not ok, on the time-vs-error chart (docs/verdicts.md).
+STATUS_MARKERS = {"stretched": "s", "unstable": "X"}
 PHASE_COLOURS = {"move": "tab:blue", "oscillate": "tab:orange", "wind": "tab:green"}
 STAGE_ORDER = ["integrate", "global_shape", "local_shape", "length", "collision"]
+SCHEMA_VERSIONS = (1, 2)
+# Distinct stage colours: tab20's saturated then light halves, its greys left out (grey
+# is "untimed").
+STAGE_PALETTE = [plt.get_cmap("tab20")(i) for i in list(range(0, 14, 2)) + [16, 18] + list(range(1, 14, 2)) + [17, 19]]
+UNTIMED_COLOUR = (0.75, 0.75, 0.75, 1.0)
+PNG_DPI = 90
 
 
 class ReportError(Exception):
@@ -61,6 +84,20 @@ def knob_text(run):
     return "" if not k else f"{k['name']}={k['value']:g}"
 
 
+def diverged(run):
+    """Whether the run stopped early (schema version 1 called that "unstable")."""
+    return run["status"] == "diverged" or ("verdict" not in run and run.get("failure") is not None)
+
+
+def verdict_text(run):
+    """The run's verdict class and, where one was decided, its frame: "ok", "stretched at
+    frame 12", "diverged at frame 3" (docs/verdicts.md). Reports of schema version 1 have
+    only status and failure."""
+    v = run.get("verdict")
+    frame = v.get("frame") if v else (run.get("failure") or {}).get("frame")
+    return run["status"] if frame is None else f"{run['status']} at frame {frame}"
+
+
 def run_label(run):
     k = knob_text(run)
     return run["model"] + (f" {k}" if k else "")
@@ -71,10 +108,23 @@ def load(path):
         with open(path, encoding="utf-8") as f:
             report = json.load(f)
     except (OSError, ValueError) as e:
-        raise ReportError(f"{path}: cannot read the report: {e}")
+        raise ReportError(f"cannot read the report: {e}")
     if report.get("schema") != "hairbench-report" or not isinstance(report.get("runs"), list):
-        raise ReportError(f"{path}: schema: not a hairbench-report")
+        raise ReportError("schema: not a hairbench-report")
+    if report.get("schema_version") not in SCHEMA_VERSIONS:
+        raise ReportError(f"schema_version: {report.get('schema_version')!r} is not one of {SCHEMA_VERSIONS}")
     return report
+
+
+def asleep(run):
+    """A run whose median step is faster than streaming its state once (roofline ratio
+    under 1) did not move its hair: the model slept through the scenario. Without a
+    roofline (GPU models), a step under 0.1 microseconds is shorter than any dispatch."""
+    ratio = run["timing"].get("roofline_ratio")
+    if ratio is not None:
+        return ratio < 1.0
+    t = num(run["timing"]["step_ms"]["median"])
+    return math.isfinite(t) and t < 1e-4
 
 
 def scenario_names(report):
@@ -131,15 +181,38 @@ def grid(n, ncols_max=3, w=5.2, h=4.0):
     return fig, flat[:n]
 
 
-def save(fig, out_dir, stem, name, written):
-    paths = []
-    for ext in ("png", "svg"):
-        p = os.path.join(out_dir, f"{stem}_{name}.{ext}")
-        fig.savefig(p, dpi=90 if ext == "png" else None, bbox_inches="tight")
-        paths.append(p)
+def save(fig, out_dir, stem, name, written, svg):
+    """PNG (a 256-colour palette: a third of the bytes of full colour, the same picture
+    for lines and flat fills) and, when asked, SVG."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=PNG_DPI, bbox_inches="tight")
+    paths = [os.path.join(out_dir, f"{stem}_{name}.png")]
+    Image.open(buf).convert("RGB").quantize(256).save(paths[0], optimize=True)
+    if svg:
+        paths.append(os.path.join(out_dir, f"{stem}_{name}.svg"))
+        fig.savefig(paths[1], bbox_inches="tight")
     plt.close(fig)
     written.extend(paths)
     return paths
+
+
+def log_axis(axis, plain, dense_decades):
+    """Readable log-axis labels whatever the range: 1-2-5 in each decade while the view
+    spans at most `dense_decades` (room for them), decades only (at most ~8) beyond;
+    never every minor tick. Under two ticks in view, matplotlib's LogLocator falls back
+    to linear ticks, which is what a sliver of a decade needs."""
+    lo, hi = sorted(axis.get_view_interval())
+    decades = math.log10(hi / lo) if lo > 0 and hi > 0 else 0.0
+    if decades > dense_decades:
+        axis.set_major_locator(matplotlib.ticker.LogLocator(base=10.0, numticks=8))
+        axis.set_minor_locator(matplotlib.ticker.LogLocator(base=10.0, subs=tuple(range(2, 10)), numticks=12))
+    else:
+        axis.set_major_locator(matplotlib.ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0), numticks=12))
+        axis.set_minor_locator(matplotlib.ticker.LogLocator(base=10.0, subs=(3.0, 4.0, 6.0, 7.0, 8.0, 9.0),
+                                                            numticks=12))
+    axis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g") if plain else
+                             matplotlib.ticker.LogFormatterSciNotation(labelOnlyBase=False))
+    axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
 def pareto_front(points):
@@ -155,25 +228,33 @@ def pareto_front(points):
 
 # --- run time vs error ------------------------------------------------------------------
 
-def chart_time_vs_error(report, out_dir, stem, written):
+def chart_time_vs_error(report, out_dir, stem, written, svg):
     names = scenario_names(report)
     colours = model_colours(report)
     fig, axes = grid(len(names))
     panels = []
     for ax, name in zip(axes, names):
         runs = [r for r in report["runs"] if r["scenario"] == name]
+        # Every run that went to the end is drawn; a stretched or unstable one is marked (its
+        # numbers are real, its behaviour is not what the method promises). A run that
+        # diverged has no comparable numbers and is named in the corner.
         stable = []
-        unstable = []
+        stopped = []
         for r in runs:
             t = num(r["timing"]["step_ms"]["median"])
             e = num(r["metrics"]["deviation_vs_reference"]["rms"])
-            if r["status"] == "ok" and math.isfinite(t) and math.isfinite(e):
+            if not diverged(r) and math.isfinite(t) and math.isfinite(e):
                 stable.append((t, e, r))
             else:
-                unstable.append(run_label(r))
+                stopped.append(run_label(r))
         positive = [e for _, e, _ in stable if e > 0]
         # log axes cannot show 0: runs identical to the reference sit on a floor line.
         floor = (min(positive) / 4.0) if positive else 1e-6
+        # A model asleep through the scenario (a few microseconds a step) would stretch the
+        # time axis over decades nobody reads: it sits on the axis floor, marked.
+        awake_t = [t for t, _, r in stable if not asleep(r) and t > 0]
+        t_floor = min(awake_t) / 3.0 if awake_t else 1e-3
+        sleepers = [run_label(r) for _, _, r in stable if asleep(r)]
         series = []
         for model in dict.fromkeys(r["model"] for r in runs):
             pts = sorted((p for p in stable if p[2]["model"] == model),
@@ -181,35 +262,43 @@ def chart_time_vs_error(report, out_dir, stem, written):
             if not pts:
                 continue
             xs = [max(e, floor) for _, e, _ in pts]
-            ys = [t for t, _, _ in pts]
-            ax.plot(xs, ys, "-o", color=colours[model], label=model, ms=5, lw=1.5)
-            for (t, e, r), x in zip(pts, xs):
+            ys = [t_floor if asleep(r) else t for t, _, r in pts]
+            ax.plot(xs, ys, "-", color=colours[model], label=model, lw=1.5)
+            for (t, e, r), x, y in zip(pts, xs, ys):
+                sleeping = asleep(r)
+                marker = STATUS_MARKERS.get(r["status"], "v" if sleeping else "o")
+                ax.plot([x], [y], marker, color=colours[model], ms=7 if sleeping or marker != "o" else 5,
+                        mfc="white" if sleeping or marker != "o" else colours[model], zorder=6)
                 if "knob" in r:
-                    ax.annotate(f"{r['knob']['value']:g}", (x, t), textcoords="offset points", xytext=(4, 4),
+                    ax.annotate(f"{r['knob']['value']:g}", (x, y), textcoords="offset points", xytext=(4, 4),
                                 fontsize=7, color=colours[model])
                 if e == 0:
-                    ax.annotate("= reference", (x, t), textcoords="offset points", xytext=(4, -10), fontsize=7)
+                    ax.annotate("= reference", (x, y), textcoords="offset points", xytext=(4, -10), fontsize=7)
             series.append({"model": model, "points": len(pts)})
-        front = pareto_front(stable)
+        front = pareto_front([p for p in stable if p[2]["status"] == "ok"])
+        for status, marker in STATUS_MARKERS.items():
+            if any(r["status"] == status for _, _, r in stable):
+                ax.plot([], [], marker, color="grey", mfc="white", label=status + " (docs/verdicts.md)")
         if front:
             fx = [max(e, floor) for _, e, _ in front]
-            fy = [t for t, _, _ in front]
+            fy = [t_floor if asleep(r) else t for t, _, r in front]
             ax.step(fx, fy, where="post", color="black", lw=1, ls="--", alpha=0.6)
             ax.scatter(fx, fy, s=110, facecolors="none", edgecolors="black", lw=1.3, label="Pareto front", zorder=5)
         if positive and any(e == 0 for _, e, _ in stable):
             ax.axvline(floor, color="grey", lw=0.6, ls=":")
+        if sleepers:
+            ax.axhline(t_floor, color="grey", lw=0.6, ls=":")
+            ax.plot([], [], "v", color="grey", mfc="white",
+                    label=textwrap.fill("asleep (step ≈ 0 ms, drawn at the floor): " + ", ".join(sleepers), 40))
         ax.set_xscale("log")
         ax.set_yscale("log")
-        # milliseconds as plain numbers (not 4x10^1); deviations keep the log labels
-        ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
-        ax.yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
         ax.set_xlabel("deviation vs reference (RMS over frames, / L̄)")
         ax.set_ylabel("median step time (ms)")
         knob = next((r["knob"]["name"] for r in runs if "knob" in r), None)
         title = f"{name}: run time vs error" + (f" over {knob}" if knob else "")
         ax.set_title(title + f"\nreference {reference_text(runs[0])}", fontsize=9)
-        if unstable:
-            ax.text(0.01, 0.01, "unstable: " + ", ".join(unstable), transform=ax.transAxes, fontsize=7,
+        if stopped:
+            ax.text(0.01, 0.01, "diverged: " + ", ".join(stopped), transform=ax.transAxes, fontsize=7,
                     color="tab:red", va="bottom")
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(fontsize=7)
@@ -218,10 +307,16 @@ def chart_time_vs_error(report, out_dir, stem, written):
             "series": series,
             "pareto": [{"model": r["model"], "knob": r.get("knob"), "step_ms": t, "deviation": e}
                        for t, e, r in front],
-            "unstable": unstable,
+            "diverged": stopped,
+            "asleep": sleepers,
         })
     fig.tight_layout()
-    return {"files": save(fig, out_dir, stem, "time_vs_error", written), "panels": panels}
+    for ax in axes:  # after the layout has fixed the view limits
+        # deviations in powers of ten (wide labels: 1-2-5 only within a decade); milliseconds
+        # as plain numbers (not 4x10^1), short enough for 1-2-5 over a few decades
+        log_axis(ax.xaxis, plain=False, dense_decades=1.0)
+        log_axis(ax.yaxis, plain=True, dense_decades=2.5)
+    return {"files": save(fig, out_dir, stem, "time_vs_error", written, svg), "panels": panels}
 
 
 # --- deviation and jaggedness over time -------------------------------------------------
@@ -231,7 +326,7 @@ def shade_phases(ax, info):
         ax.axvspan(p["start"], p["end"], color=PHASE_COLOURS.get(p["kind"], "grey"), alpha=0.12, lw=0)
 
 
-def chart_timeseries(report, out_dir, stem, written):
+def chart_timeseries(report, out_dir, stem, written, svg):
     names = scenario_names(report)
     colours = model_colours(report)
     fig, axes = plt.subplots(len(names), 2, figsize=(13, 3.3 * len(names)), squeeze=False)
@@ -270,29 +365,39 @@ def chart_timeseries(report, out_dir, stem, written):
         row[1].legend(handles, labels, fontsize=7, loc="upper right", ncol=2 if len(labels) > 8 else 1)
         panels.append(panel)
     fig.tight_layout()
-    return {"files": save(fig, out_dir, stem, "timeseries", written), "panels": panels}
+    return {"files": save(fig, out_dir, stem, "timeseries", written, svg), "panels": panels}
 
 
 # --- stage time breakdown ---------------------------------------------------------------
 
-def chart_stages(report, out_dir, stem, written):
-    names = scenario_names(report)
-    fig, axes = grid(len(names), ncols_max=2, w=6.5, h=4.2)
-    cmap = plt.get_cmap("Set2")
-    all_stages = []
+def stage_colours(report):
+    """One colour per stage name in the report, the same in every panel, no two alike."""
+    names = []
     for r in report["runs"]:
         for s in r["timing"].get("stage_ms", {}):
-            if s not in all_stages:
-                all_stages.append(s)
-    all_stages.sort(key=lambda s: (STAGE_ORDER.index(s) if s in STAGE_ORDER else len(STAGE_ORDER), s))
-    stage_colour = {s: cmap(i % 8) for i, s in enumerate(all_stages)}
-    stage_colour["untimed"] = (0.8, 0.8, 0.8, 1.0)
+            if s not in names:
+                names.append(s)
+    names.sort(key=lambda s: (STAGE_ORDER.index(s) if s in STAGE_ORDER else len(STAGE_ORDER), s))
+    if len(names) <= len(STAGE_PALETTE):
+        palette = STAGE_PALETTE[:len(names)]
+    else:  # more names than the table: hues spread evenly
+        palette = [matplotlib.colors.hsv_to_rgb((i / len(names), 0.65, 0.85)) for i in range(len(names))]
+    colours = {s: tuple(matplotlib.colors.to_rgba(c)) for s, c in zip(names, palette)}
+    colours["untimed"] = UNTIMED_COLOUR
+    return names, colours
+
+
+def chart_stages(report, out_dir, stem, written, svg):
+    names = scenario_names(report)
+    fig, axes = grid(len(names), ncols_max=2, w=7.5, h=4.2)
+    all_stages, stage_colour = stage_colours(report)
     panels = []
     for ax, name in zip(axes, names):
         runs = [r for r in report["runs"] if r["scenario"] == name]
         labels = [run_label(r) for r in runs]
         bottom = [0.0] * len(runs)
         segments = []
+        handles = []
         for stage in all_stages + ["untimed"]:
             vals = []
             for r in runs:
@@ -307,28 +412,35 @@ def chart_stages(report, out_dir, stem, written):
                     vals.append(v if math.isfinite(v) else 0.0)
             if not any(vals):
                 continue
-            ax.bar(range(len(runs)), vals, bottom=bottom, color=stage_colour[stage], label=stage)
+            handles.append(ax.bar(range(len(runs)), vals, bottom=bottom, color=stage_colour[stage], label=stage))
             bottom = [b + v for b, v in zip(bottom, vals)]
             segments.append(stage)
-        # Stages a scene did not need are 0 ms; name them over the bar so "skipped" is
-        # visible rather than silently absent (issue 8).
-        skipped_runs = 0
-        for i, r in enumerate(runs):
-            skipped = sorted(r["timing"].get("stage_skipped_steps", {}))
+        # Stages a scene did not need are 0 ms: the legend (outside the bars) says which
+        # run skipped which, in how many of its steps, so "skipped" is not silently absent.
+        skipped_lines = []
+        for r in runs:
+            skipped = r["timing"].get("stage_skipped_steps", {})
             if skipped:
-                skipped_runs += 1
-                ax.annotate("skipped: " + ", ".join(skipped), (i, bottom[i]), xytext=(0, 3),
-                            textcoords="offset points", ha="center", va="bottom", fontsize=6, rotation=90)
+                steps = r.get("frames_run", r["frames"])
+                by_count = {}
+                for stage, n in sorted(skipped.items()):
+                    by_count.setdefault(n, []).append(stage)
+                text = f"{run_label(r)}: " + "; ".join(f"{', '.join(st)} {n}/{steps}" for n, st in by_count.items())
+                skipped_lines.append(textwrap.fill(text, 44, subsequent_indent="   "))
+        labels_all = [h.get_label() for h in handles]
+        if skipped_lines:
+            handles.append(Patch(visible=False))
+            labels_all.append("skipped in (steps/run):\n" + "\n".join(skipped_lines))
+        ax.legend(handles, labels_all, fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
         ax.set_xticks(range(len(runs)))
-        ax.set_xticklabels(labels, rotation=40 if len(runs) > 3 else 0, ha="right" if len(runs) > 3 else "center",
-                           fontsize=7)
+        ax.set_xticklabels(labels, rotation=90, fontsize=7)
         ax.set_ylabel("ms per step (mean)")
         ax.set_title(f"{name}: time per solver stage", fontsize=9)
-        ax.legend(fontsize=7)
         ax.grid(True, axis="y", alpha=0.25)
-        panels.append({"scenario": name, "bars": len(runs), "stages": segments, "runs_with_skipped": skipped_runs})
+        panels.append({"scenario": name, "bars": len(runs), "stages": segments, "runs_with_skipped": len(skipped_lines),
+                       "colours": {s: matplotlib.colors.to_hex(stage_colour[s]) for s in segments}})
     fig.tight_layout()
-    return {"files": save(fig, out_dir, stem, "stages", written), "panels": panels}
+    return {"files": save(fig, out_dir, stem, "stages", written, svg), "panels": panels}
 
 
 # --- strand pictures --------------------------------------------------------------------
@@ -347,13 +459,58 @@ def camera(points, centre):
     return out
 
 
-def strand_points(flat):
-    return [(num(flat[i]), num(flat[i + 1]), num(flat[i + 2])) for i in range(0, len(flat) - 2, 3)]
+B64 = {c: i for i, c in enumerate("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/")}
 
 
-def chart_strands(report, out_dir, stem, written):
+def decode_strand(code, ref=None):
+    """A snapshot strand -> [x0, y0, z0, x1, ...] in metres. Schema 1: the list itself;
+    schema 2 (reports/report.h, encode_snapshot_strand): base64 of zigzag LEB128 varints,
+    each the residual of a coordinate in 10-micrometre units (less the reference strand
+    `ref`'s, decoded, for a snapshot marked relative_to_reference) from its prediction by
+    the same axis of the two vertices before it; null: no finite position."""
+    if code is None:
+        return []
+    if isinstance(code, list):
+        return [num(v) for v in code]
+    try:
+        data = base64.b64decode(code, validate=True)
+    except ValueError as e:
+        raise ReportError(f"snapshots: strand {code[:16]!r}: not base64 ({e})")
+    q = []
+    z = shift = 0
+    for b in data:
+        z |= (b & 0x7F) << shift
+        shift += 7
+        if b & 0x80:
+            continue
+        n = len(q)
+        q.append(((z >> 1) ^ -(z & 1)) + (2 * q[n - 3] - q[n - 6] if n >= 6 else q[n - 3] if n >= 3 else 0))
+        z = shift = 0
+    if shift or len(q) % 3 or (ref is not None and len(ref) != len(q)):
+        raise ReportError(f"snapshots: strand {code[:16]!r}: truncated, or not as long as the reference's")
+    if ref is not None:
+        q = [v + round(r / 1e-5) for v, r in zip(q, ref)]
+    return [v * 1e-5 for v in q]
+
+
+def points(flat):
+    return [(flat[i], flat[i + 1], flat[i + 2]) for i in range(0, len(flat) - 2, 3)]
+
+
+def snapshot_strands(snap, ref_flat):
+    """Every strand of a snapshot as [(x, y, z), ...] ([] where null); `ref_flat`: the
+    reference's strands at that frame, decoded (None when it has none)."""
+    codes = snap.get("strands") or []
+    refs = [None] * len(codes)
+    if snap.get("relative_to_reference"):
+        if ref_flat is None or len(ref_flat) != len(codes):
+            raise ReportError(f"snapshots: {snap['label']}: relative to a reference snapshot the report lacks")
+        refs = ref_flat
+    return [points(decode_strand(code, ref)) for code, ref in zip(codes, refs)]
+
+
+def chart_strands(report, out_dir, stem, written, svg):
     out = []
-    colours = None
     for name in scenario_names(report):
         info = scenario_info(report, name)
         snaps = (info or {}).get("snapshots")
@@ -378,6 +535,8 @@ def chart_strands(report, out_dir, stem, written):
         for fi, frame in enumerate(frames):
             centre = frame["head"]["translation"]
             ref_snap = ref_by_label.get(frame["label"])
+            ref_flat = [decode_strand(c) for c in ref_snap["strands"]] if ref_snap and ref_snap.get("strands") else None
+            ref_strands = [points(f) for f in ref_flat or []]
             for ci, (label, by_label) in enumerate(columns):
                 ax = axes[fi][ci]
                 ax.set_aspect("equal")
@@ -391,13 +550,12 @@ def chart_strands(report, out_dir, stem, written):
                                   fontsize=8)
                 snap = by_label.get(frame["label"])
                 if not snap or not snap.get("strands"):
-                    ax.text(0, 0, "not reached\n(unstable)", ha="center", va="center", fontsize=8, color="tab:red")
+                    ax.text(0, 0, "not reached\n(diverged)", ha="center", va="center", fontsize=8, color="tab:red")
                     collections.append(None)
                     continue
                 segs, devs = [], []
-                for si, flat in enumerate(snap["strands"]):
-                    pts = strand_points(flat)
-                    refp = strand_points(ref_snap["strands"][si]) if ref_snap and ref_snap.get("strands") else None
+                for si, pts in enumerate(snapshot_strands(snap, ref_flat)):
+                    refp = ref_strands[si] if si < len(ref_strands) else None
                     d = [math.dist(p, q) / lbar for p, q in zip(pts, refp)] if refp else [0.0] * len(pts)
                     xy = camera(pts, centre)
                     for v in range(len(xy) - 1):
@@ -409,7 +567,8 @@ def chart_strands(report, out_dir, stem, written):
                             box = [min(box[0], x), min(box[1], y), max(box[2], x), max(box[3], y)]
                 finite = [x for x in devs if math.isfinite(x)]
                 vmax = max([vmax] + finite)
-                lc = LineCollection(segs, cmap="viridis", linewidths=0.7)
+                # thousands of segments: a raster inside an SVG, not one path each
+                lc = LineCollection(segs, cmap="viridis", linewidths=0.7, rasterized=True)
                 lc.set_array(devs)
                 ax.add_collection(lc)
                 collections.append((lc, len(snap["strands"])))
@@ -429,7 +588,7 @@ def chart_strands(report, out_dir, stem, written):
             cb.set_label("per-vertex deviation |p − p_ref| / L̄", fontsize=8)
         fig.suptitle(f"{name}: {len(snaps['strands'])} strands of the groom, coloured by deviation from the "
                      f"reference ({reference_text(runs[0])})", fontsize=10)
-        files = save(fig, out_dir, stem, f"strands_{name}", written)
+        files = save(fig, out_dir, stem, f"strands_{name}", written, svg)
         out.append({"scenario": name, "files": files, "frames": [f["label"] for f in frames],
                     "columns": [c[0] for c in columns], "panels": len(collections),
                     "strands_per_panel": [c[1] if c else 0 for c in collections], "max_deviation": vmax})
@@ -450,8 +609,7 @@ def table_rows(report, name, pareto):
             continue
         m = r["metrics"]
         on_front = (r["model"], json.dumps(r.get("knob"), sort_keys=True)) in front
-        status = r["status"] if r["status"] == "ok" else f"{r['status']} at frame {r['failure']['frame']}"
-        rows.append([r["model"], knob_text(r) or "–", status, fmt(r["timing"]["step_ms"]["median"]),
+        rows.append([r["model"], knob_text(r) or "–", verdict_text(r), fmt(r["timing"]["step_ms"]["median"]),
                      fmt(r["timing"]["ns_per_vertex"], ".1f"), fmt(m["deviation_vs_reference"]["rms"]),
                      fmt(m["deviation_vs_reference"]["max"]), fmt(m["jaggedness"]["mean"]),
                      fmt(m["length_error"]["rms"], ".2g"), fmt(m["rest_shape_error"]),
@@ -504,6 +662,78 @@ def img_tag(png, alt):
            f'{html.escape(alt)}</figcaption></figure>'
 
 
+def overview(report):
+    """Rows (run labels: the models of a compare, model and knob value in a sweep) by
+    scenarios; each cell the run's verdict, its median step over the reference model's in
+    that scenario, its deviation and its jaggedness."""
+    names = scenario_names(report)
+    rows = list(dict.fromkeys(run_label(r) for r in report["runs"]))
+    cells = {}
+    for name in names:
+        runs = [r for r in report["runs"] if r["scenario"] == name]
+        ref_model = runs[0]["metrics"]["deviation_vs_reference"].get("reference", "han_m1")
+        # the reference model's own run at the scenario's parameters, when it is one of them
+        ref_run = next((r for r in runs if r["model"] == ref_model
+                        and r["metrics"]["deviation_vs_reference"]["max"] == 0), None)
+        ref_t = num(ref_run["timing"]["step_ms"]["median"]) if ref_run else float("nan")
+        for r in runs:
+            t = num(r["timing"]["step_ms"]["median"])
+            cells[(run_label(r), name)] = {
+                "status": r["status"],
+                "verdict": verdict_text(r),
+                "asleep": asleep(r),
+                "speed": t / ref_t if ref_t > 0 and math.isfinite(t) else float("nan"),
+                "deviation": num(r["metrics"]["deviation_vs_reference"]["rms"]),
+                "jaggedness": num(r["metrics"]["jaggedness"]["mean"]),
+            }
+    return rows, names, cells
+
+
+DEV_NORM = matplotlib.colors.LogNorm(vmin=1e-4, vmax=1.0)
+STATUS_COLOURS = {"stretched": "#fbe99a", "unstable": "#f9b56b", "diverged": "#ef8a8a"}
+
+
+def cell_colour(c):
+    """A verdict other than ok in its own warm colour (yellow, orange, red); an ok run's
+    deviation on a log scale, 1e-4 L̄ (white) to 1 L̄ (blue), so that no deviation can be
+    mistaken for a verdict; the reference itself pale grey."""
+    if c["status"] in STATUS_COLOURS:
+        return STATUS_COLOURS[c["status"]]
+    d = c["deviation"]
+    if not math.isfinite(d):
+        return "#eeeeee"
+    if d == 0:
+        return "#e4e4e4"
+    rgb = plt.get_cmap("Blues")(0.05 + 0.5 * float(DEV_NORM(min(max(d, 1e-4), 1.0))))[:3]
+    return matplotlib.colors.to_hex(rgb)
+
+
+def overview_html(report):
+    e = html.escape
+    rows, names, cells = overview(report)
+    out = ["<h2 id='overview'>Overview</h2>",
+           "<p>Each cell: verdict; median step time relative to the reference model's run in that scenario "
+           "(×, lower is faster); deviation from the reference (RMS over frames, / L̄); jaggedness (mean). "
+           "Colour: yellow stretched, orange unstable, red diverged (docs/verdicts.md); an ok run's deviation on a "
+           "log scale from 10⁻⁴ (white) to 1 (blue); grey: the reference itself.</p>",
+           "<table class='overview'><tr><th>model</th>" + "".join(f"<th>{e(n)}</th>" for n in names) + "</tr>"]
+    for row in rows:
+        tds = [f"<th>{e(row)}</th>"]
+        for name in names:
+            c = cells.get((row, name))
+            if c is None:
+                tds.append("<td class='none'>–</td>")
+                continue
+            verdict = "asleep" if c["status"] == "ok" and c["asleep"] else c["verdict"]
+            v = c["speed"]
+            speed = "–" if not math.isfinite(v) else f"×{v:.0f}" if v >= 10 else f"×{v:.2g}"
+            tds.append(f"<td style='background:{cell_colour(c)}'><b>{e(verdict)}</b><br>{e(speed)}<br>"
+                       f"dev {e(fmt(c['deviation'], '.2g'))}<br>jag {e(fmt(c['jaggedness'], '.2g'))}</td>")
+        out.append("<tr>" + "".join(tds) + "</tr>")
+    out.append("</table>")
+    return out
+
+
 def write_html(report, path, charts, pareto_by_scenario):
     e = html.escape
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>hairbench report</title><style>",
@@ -511,10 +741,15 @@ def write_html(report, path, charts, pareto_by_scenario):
              "font-size:13px;margin:0.5em 0 1.5em}td,th{border:1px solid #ccc;padding:3px 7px;text-align:right}"
              "td:first-child,td:nth-child(2),td:nth-child(3){text-align:left}th{background:#eee}"
              "img{max-width:100%}figure{margin:1em 0}figcaption{color:#555;font-size:13px}"
-             "tr.front td{background:#eef7ee}",
+             "tr.front td{background:#eef7ee}table.overview td{text-align:center;font-size:12px;line-height:1.3}"
+             "table.overview th{text-align:left}",
              "</style></head><body>", "<h1>hairbench report</h1>", f"<p>{e(context_line(report))}</p>"]
+    parts += overview_html(report)
+    parts.append(img_tag(charts["time_vs_error"]["files"][0], "Run time against error (log–log); the Pareto front "
+                         "is ringed; runs asleep through a scenario sit on the time axis's floor"))
+    parts.append("<h2>Details</h2>")
     for name in scenario_names(report):
-        parts.append(f"<h2>{e(name)}</h2><ul>")
+        parts.append(f"<h3>{e(name)}</h3><ul>")
         parts += [f"<li>{e(n)}</li>" for n in scenario_notes(report, name)]
         parts.append("</ul><table><tr>" + "".join(f"<th>{e(c)}</th>" for c in COLUMNS) + "</tr>")
         for row in table_rows(report, name, pareto_by_scenario.get(name, [])):
@@ -522,11 +757,10 @@ def write_html(report, path, charts, pareto_by_scenario):
             parts.append(f"<tr{cls}>" + "".join(f"<td>{e(c)}</td>" for c in row) + "</tr>")
         parts.append("</table>")
     parts.append("<h2>Charts</h2>")
-    parts.append(img_tag(charts["time_vs_error"]["files"][0], "Run time against error (log–log); the Pareto front "
-                         "is ringed"))
     parts.append(img_tag(charts["timeseries"]["files"][0], "Deviation from the reference and jaggedness over "
                          "time; script phases shaded, the most violent frame dotted"))
-    parts.append(img_tag(charts["stages"]["files"][0], "Time per solver stage (mean per step)"))
+    parts.append(img_tag(charts["stages"]["files"][0], "Time per solver stage (mean per step); the legend lists the "
+                         "stages each run skipped"))
     for s in charts["strands"]:
         parts.append(img_tag(s["files"][0], f"{s['scenario']}: most violent and final frame, strands coloured by "
                              f"per-vertex deviation from the reference"))
@@ -539,26 +773,29 @@ def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("report")
     ap.add_argument("--out-dir", help="where to write (default: the report's folder)")
+    ap.add_argument("--svg", action="store_true",
+                    help="also write every chart as SVG (default: HAIRBENCH_SVG=1 in the environment)")
     args = ap.parse_args(argv)
+    svg = args.svg or os.environ.get("HAIRBENCH_SVG", "") not in ("", "0")
     try:
         report = load(args.report)
         if not report["runs"]:
-            raise ReportError(f"{args.report}: runs: the report has no runs")
-    except ReportError as e:
-        print(f"charts.py: {e}", file=sys.stderr)
-        return 2
-    out_dir = args.out_dir or os.path.dirname(os.path.abspath(args.report))
-    os.makedirs(out_dir, exist_ok=True)
-    stem = os.path.splitext(os.path.basename(args.report))[0]
-    plt.rcParams.update({"font.size": 8, "svg.fonttype": "none"})
+            raise ReportError("runs: the report has no runs")
+        out_dir = args.out_dir or os.path.dirname(os.path.abspath(args.report))
+        os.makedirs(out_dir, exist_ok=True)
+        stem = os.path.splitext(os.path.basename(args.report))[0]
+        plt.rcParams.update({"font.size": 8, "svg.fonttype": "none"})
 
-    written = []
-    charts = {
-        "time_vs_error": chart_time_vs_error(report, out_dir, stem, written),
-        "timeseries": chart_timeseries(report, out_dir, stem, written),
-        "stages": chart_stages(report, out_dir, stem, written),
-        "strands": chart_strands(report, out_dir, stem, written),
-    }
+        written = []
+        charts = {
+            "time_vs_error": chart_time_vs_error(report, out_dir, stem, written, svg),
+            "timeseries": chart_timeseries(report, out_dir, stem, written, svg),
+            "stages": chart_stages(report, out_dir, stem, written, svg),
+            "strands": chart_strands(report, out_dir, stem, written, svg),
+        }
+    except ReportError as e:
+        print(f"charts.py: {args.report}: {e}", file=sys.stderr)
+        return 2
     pareto = {p["scenario"]: p["pareto"] for p in charts["time_vs_error"]["panels"]}
     md = os.path.join(out_dir, f"{stem}_summary.md")
     write_markdown(report, md, pareto)

@@ -1,4 +1,4 @@
-// The per-frame metrics of DESIGN.md ("Metrics (contract)"). All are computed by the
+// The per-frame metrics (docs/metrics.md). All are computed by the
 // harness from positions alone, so every model is measured by the same code.
 #pragma once
 
@@ -22,7 +22,15 @@ struct RestInfo {
   std::vector<float> rest_length;        // per edge, indexed by its second vertex
   std::size_t edge_count;                // edges of all strands (vertices less one per strand)
   double mean_strand_length;             // L-bar
-  std::vector<double> rest_jaggedness;   // per strand, raw (not rest-subtracted)
+  // The length scale s of each strand's edge errors (length_error): the median of its rest
+  // edge lengths, or, where that is 0 or below 1e-6 of the mean rest edge of the simulated
+  // strands, that mean. Exporters write edges of 0 m and 2.4e-7 m, whose own length would
+  // turn float rounding into a 100% error.
+  std::vector<double> edge_scale;         // per strand
+  std::vector<double> vertex_edge_scale;  // per vertex, its strand's edge_scale (the loops over the groom)
+  // d0, the |kb_{i+1} - kb_i| of the rest shape (strand_kb_changes): per vertex, indexed
+  // as strand_kb_changes writes them.
+  std::vector<double> rest_kb_change;
   // The strands jaggedness computes several at a time (one size >= 4, in groups of its
   // lane count, metrics.cpp), and the others, one at a time; each in index order.
   std::vector<std::uint32_t> jagged_grouped, jagged_alone;
@@ -33,18 +41,37 @@ struct RestInfo {
 // sqrt(mean over vertices |p - p_ref|^2) / L-bar.
 double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double mean_length);
 
-// sqrt(mean_i |kb_{i+1} - kb_i|^2) of one strand, with the discrete curvature binormal
-// kb_i = 2 (e_{i-1} x e_i) / (|e_{i-1}||e_i| + e_{i-1}.e_i) (Bergou et al. 2008);
-// 0 for strands with fewer than 4 vertices (no pair of binormals).
-double strand_jaggedness_raw(std::span<const Vec4f> strand);
-// Groom jaggedness: mean over strands of (raw - raw on the rest shape).
+// Jaggedness reads new kinks: how much the change of curvature along each strand differs
+// from the rest shape's. With the discrete curvature binormal at interior vertex i
+//   kb_i = 2 (e_{i-1} x e_i) / (|e_{i-1}||e_i| + e_{i-1}.e_i)      (Bergou et al. 2008)
+// (e_i = p_{i+1} - p_i; |kb_i| = 2 tan(phi_i / 2) for the turning angle phi_i), the change
+// between neighbours d_i = |kb_{i+1} - kb_i|, and d0_i the same on the rest shape,
+//   J_s = sqrt( mean_i (d_i - d0_i)^2 ),   i = 1 .. n-3 (n vertices, n-3 pairs; 0 if n < 4)
+//   jaggedness = mean over strands of J_s.
+// J_s >= 0, and 0 on the rest shape. kb is a vector that turns with the strand, so d_i is
+// unchanged by a rigid motion (up to the rounding of the moved float positions). A uniform
+// bend keeps kb nearly constant along the strand (d ~ 0), a zig-zag flips it at every
+// vertex (d ~ 2|kb|): the metric reads new changes of curvature, not curvature, and a
+// styled wave or curl flattened out scores above 0 like any other departure from rest.
+
+// d_i of one strand, written to out[i + 1] (the vertex of kb_{i+1}) for i = 1 .. n-3;
+// out[0], out[1] and out[n-1] are left as they are. out.size() == strand.size().
+void strand_kb_changes(std::span<const Vec4f> strand, std::span<double> out);
+// J_s of one strand, with rest_kb_change its strand's span of RestInfo::rest_kb_change
+// (indexed as strand_kb_changes writes them).
+double strand_jaggedness(std::span<const Vec4f> strand, std::span<const double> rest_kb_change);
+// Groom jaggedness: mean over strands of strand_jaggedness.
 double jaggedness(const RestInfo& rest, std::span<const Vec4f> p);
 
 struct LengthError {
   double rms = 0.0;
   double max = 0.0;
+  // Where max is: the strand, and the edge by its second vertex's index within the strand
+  // (edge k joins vertices k-1 and k, k >= 1, as blowup_reason names edges). The first such
+  // edge in strand order; 0 and 0 when max is 0.
+  std::uint32_t worst_strand = 0, worst_edge = 0;
 };
-// |edge - rest edge| / rest edge over all edges.
+// |edge - rest edge| / s over all edges, s the edge's strand's RestInfo::edge_scale.
 LengthError length_error(const RestInfo& rest, std::span<const Vec4f> p);
 
 // sqrt(mean |p - T_H p^0|^2) / L-bar: deviation from the head-transformed rest shape.
@@ -53,13 +80,13 @@ double rest_shape_error(const RestInfo& rest, std::span<const Vec4f> p, const Af
 // Deepest vertex inside any sphere (xyz centre, w radius), metres; 0 if none.
 double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_spheres);
 
-// Empty if the state is sane, else why the model is declared unstable: NaN/Inf, an edge of
-// a simulated strand stretched or shrunk by more than 50%, or a vertex farther than
-// 10 L-bar from the head (beyond the head's extent about `head_center`: see metrics.cpp).
+// Empty if the state is sane, else why the model has diverged: NaN/Inf, or a vertex farther
+// than 10 L-bar from the head (beyond the head's extent about `head_center`: see
+// metrics.cpp). Stretched edges are the `stretched` verdict's (reports/verdict.h).
 std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center);
 
 // Mean specific mechanical energy per vertex, in J/kg: kinetic ½|v|² with the frame's
-// velocity v = (p - prev) / dt, plus gravitational -g·p. The stress test's growth check
+// velocity v = (p - prev) / dt, plus gravitational -g·p. The divergence check's energy growth test
 // watches it while nothing drives the hair.
 double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt, const Vec3f& gravity);
 

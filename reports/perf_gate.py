@@ -12,7 +12,7 @@ Instructions: the same decision on callgrind instruction counts (one sample each
 deterministic, so only the threshold applies).
 
 Accuracy: per model x scenario of two hairbench reports, the metrics must not worsen by
-more than their stated tolerance, and no run may become unstable.
+more than their stated tolerance, and no run that was ok may get another verdict.
 
 Exit codes: 0 pass, 1 regression, 2 could not run. Standard library only, so it runs
 with any Python 3.
@@ -246,7 +246,7 @@ def judge_accuracy(base_path, base_doc, cand_path, cand_doc):
         b, c = base[key], cand[key]
         label = f"{key[1]} / {key[0]}" + (f" [{key[2]}]" if key[2] else "")
         if b.get("status") == "ok" and c.get("status") != "ok":
-            rows.append((label, "status", "ok", c.get("status"), "REGRESSION (unstable)"))
+            rows.append((label, "status", "ok", c.get("status"), "REGRESSION (no longer ok)"))
             continue
         for path, (rel, floor) in ACCURACY_TOLERANCES.items():
             vb, vc = _metric(b, path), _metric(c, path)
@@ -328,7 +328,7 @@ def main(argv=None):
             failed |= any(r[4].startswith("REGRESSION") for r in rows)
             tol = ", ".join(f"{'.'.join(k)} +max({r:.0%}, {a:g})"
                             for k, (r, a) in ACCURACY_TOLERANCES.items())
-            sections.append(f"### Accuracy (tolerances: {tol}; any newly unstable run "
+            sections.append(f"### Accuracy (tolerances: {tol}; a run no longer ok "
                             "fails)\n\n" + accuracy_table(rows))
         if not sections:
             raise GateError("nothing to compare: give benchmark, count or report files")

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <numeric>
@@ -17,7 +18,7 @@ namespace hairbench {
 
 namespace {
 
-// NaN and Inf are never bare tokens in the report: they become null (DESIGN.md).
+// NaN and Inf are never bare tokens in the report: they become null (docs/report-schema.md).
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 nlohmann::json series(const std::vector<double>& v) {
@@ -72,17 +73,32 @@ std::string cpu_name() {
 // tree's copy answered 252324f for binaries built from a4fe085).
 std::string git_sha() { return HAIRBENCH_GIT_SHA; }
 
-// Snapshot coordinates to 10 micrometres: enough for a picture and for per-vertex
-// deviation (L-bar is centimetres), and it keeps the numbers short in the JSON.
-nlohmann::json snapshot_json(const RunRecord::Snapshot& s) {
-  nlohmann::json strands = nlohmann::json::array();
-  for (const auto& xyz : s.strands) {
-    nlohmann::json a = nlohmann::json::array();
-    for (float x : xyz) a.push_back(std::isfinite(x) ? nlohmann::json(std::round(double(x) * 1e5) / 1e5) : nlohmann::json(nullptr));
-    strands.push_back(std::move(a));
-  }
-  return {{"label", s.label}, {"frame", s.frame}, {"strands", std::move(strands)}};
+// A run's snapshot is written relative to the reference's at the same frame when the
+// reference reached it with every strand finite and of the same length: most runs follow
+// the reference to within millimetres, so the residuals shrink to a byte.
+bool relative_to(const RunRecord::Snapshot& s, const RunRecord::Snapshot* ref) {
+  if (!ref || ref->strands.size() != s.strands.size() || s.strands.empty()) return false;
+  for (std::size_t i = 0; i < s.strands.size(); ++i)
+    if (ref->strands[i].size() != s.strands[i].size() || !encode_snapshot_strand(ref->strands[i])) return false;
+  return true;
 }
+
+nlohmann::json snapshot_json(const RunRecord::Snapshot& s, const RunRecord::Snapshot* ref = nullptr) {
+  const bool relative = relative_to(s, ref);
+  nlohmann::json strands = nlohmann::json::array();
+  for (std::size_t i = 0; i < s.strands.size(); ++i) {
+    const std::optional<std::string> code = encode_snapshot_strand(s.strands[i], relative ? &ref->strands[i] : nullptr);
+    strands.push_back(code ? nlohmann::json(*code) : nlohmann::json(nullptr));
+  }
+  nlohmann::json out = {{"label", s.label}, {"frame", s.frame}, {"strands", std::move(strands)}};
+  if (relative) out["relative_to_reference"] = true;
+  return out;
+}
+
+constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+// Beyond this a position is a blown-up run, not hair: the strand is written as null.
+constexpr double kSnapshotMaxMetres = 1e6;
 
 std::string utc_now() {
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
@@ -94,6 +110,76 @@ std::string utc_now() {
 }
 
 }  // namespace
+
+// Hair strands are smooth, so each vertex is close to the straight-line extrapolation of
+// the two before it: the residuals of that prediction, in 10-micrometre units, are a few
+// hundred at most and take one or two bytes as varints, where the decimal text took eight
+// (the snapshots of a default compare are 1.8 million coordinates).
+std::optional<std::string> encode_snapshot_strand(const std::vector<float>& xyz, const std::vector<float>* ref) {
+  std::vector<std::int64_t> q(xyz.size());
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    if (!std::isfinite(xyz[i]) || std::abs(double(xyz[i])) > kSnapshotMaxMetres) return std::nullopt;
+    q[i] = std::llround(double(xyz[i]) / kSnapshotUnitMetres);
+    if (ref) q[i] -= std::llround(double((*ref)[i]) / kSnapshotUnitMetres);
+  }
+  std::string bytes;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const std::int64_t pred = i >= 6 ? 2 * q[i - 3] - q[i - 6] : i >= 3 ? q[i - 3] : 0;
+    const std::int64_t r = q[i] - pred;
+    std::uint64_t z = (static_cast<std::uint64_t>(r) << 1) ^ static_cast<std::uint64_t>(r >> 63);
+    for (; z >= 0x80; z >>= 7) bytes.push_back(static_cast<char>((z & 0x7f) | 0x80));
+    bytes.push_back(static_cast<char>(z));
+  }
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
+    std::uint32_t w = 0;
+    for (std::size_t k = 0; k < 3; ++k)
+      w = (w << 8) | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k) out.push_back(k <= n ? kBase64[(w >> (18 - 6 * k)) & 0x3f] : '=');
+  }
+  return out;
+}
+
+std::vector<double> decode_snapshot_strand(std::string_view code, const std::vector<double>* ref) {
+  auto fail = [&](const char* why) {
+    throw std::runtime_error("snapshot strand \"" + std::string(code.substr(0, 16)) + "\": " + why);
+  };
+  if (code.size() % 4) fail("base64 length is not a multiple of 4");
+  std::string bytes;
+  for (std::size_t i = 0; i < code.size(); i += 4) {
+    std::uint32_t w = 0;
+    std::size_t pad = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const char c = code[i + k];
+      const char* at = c == '=' ? nullptr : std::strchr(kBase64, c);
+      if (c == '=') ++pad;
+      else if (!at || !c || pad) fail("not base64");
+      w = (w << 6) | (at ? static_cast<std::uint32_t>(at - kBase64) : 0u);
+    }
+    if (pad > 2 || (pad && i + 4 != code.size())) fail("misplaced base64 padding");
+    for (std::size_t k = 0; k < 3 - pad; ++k) bytes.push_back(static_cast<char>((w >> (16 - 8 * k)) & 0xff));
+  }
+  std::vector<std::int64_t> q;
+  for (std::size_t i = 0; i < bytes.size();) {
+    std::uint64_t z = 0;
+    for (int shift = 0;; shift += 7) {
+      if (i >= bytes.size() || shift > 63) fail("truncated varint");
+      const auto b = static_cast<unsigned char>(bytes[i++]);
+      z |= std::uint64_t(b & 0x7f) << shift;
+      if (!(b & 0x80)) break;
+    }
+    const auto r = static_cast<std::int64_t>(z >> 1) ^ -static_cast<std::int64_t>(z & 1);
+    const std::size_t n = q.size();
+    q.push_back(r + (n >= 6 ? 2 * q[n - 3] - q[n - 6] : n >= 3 ? q[n - 3] : 0));
+  }
+  if (q.size() % 3) fail("coordinate count is not a multiple of 3");
+  if (ref && ref->size() != q.size()) fail("not as long as the reference's strand");
+  std::vector<double> xyz(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i)
+    xyz[i] = static_cast<double>(q[i] + (ref ? std::llround((*ref)[i] / kSnapshotUnitMetres) : 0)) * kSnapshotUnitMetres;
+  return xyz;
+}
 
 double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
 
@@ -121,18 +207,35 @@ nlohmann::json context_json(const ReportContext& ctx) {
           {"devices", nlohmann::json::array()}};
 }
 
-nlohmann::json run_json(const RunRecord& r) {
+nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   const std::size_t done = r.step_ms.size();
+  // The headline times cover the frames where the model worked: a frame in which every
+  // strand slept is skipping's saving, not the method's speed, and counting it would
+  // compare one model's sleep with another's work. The sleep is reported beside them.
+  std::vector<double> worked, asleep;
+  for (std::size_t f = 0; f < done; ++f) {
+    const bool work = f >= r.worked.size() || r.worked[f];
+    (work ? worked : asleep).push_back(r.step_ms[f]);
+  }
   nlohmann::json stage = nlohmann::json::object();
-  for (const auto& [name, total] : r.stage_ms_total) stage[name] = num(done ? total / static_cast<double>(done) : 0.0);
+  const double per = worked.empty() ? 0.0 : 1.0 / static_cast<double>(worked.size());
+  for (const auto& [name, total] : r.stage_ms_total) stage[name] = num(total * per);
 
-  const double med = median(r.step_ms);
+  const double med = median(worked);
+  double asleep_ms = 0.0;
+  for (double ms : asleep) asleep_ms += ms;
   nlohmann::json timing = {
       {"step_ms",
-       {{"mean", num(finite_mean(r.step_ms))},
+       {{"frames", "worked"},
+        {"count", worked.size()},
+        {"mean", num(finite_mean(worked))},
         {"median", num(med)},
-        {"min", num(r.step_ms.empty() ? NAN : *std::min_element(r.step_ms.begin(), r.step_ms.end()))},
-        {"p95", num(percentile(r.step_ms, 0.95))}}},
+        {"min", num(worked.empty() ? NAN : *std::min_element(worked.begin(), worked.end()))},
+        {"p95", num(percentile(worked, 0.95))}}},
+      {"sleep",
+       {{"frames_asleep", asleep.size()},
+        {"ms_asleep", asleep_ms},
+        {"ms_saved", num(static_cast<double>(asleep.size()) * med - asleep_ms)}}},
       {"stage_ms", stage},
       {"stage_skipped_steps", r.stage_skipped_steps},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
@@ -169,7 +272,13 @@ nlohmann::json run_json(const RunRecord& r) {
   if (r.failure) failure = {{"frame", r.failure->frame}, {"t", r.failure->t}, {"reason", r.failure->reason}};
 
   nlohmann::json snapshots = nlohmann::json::array();
-  for (const auto& snap : r.snapshots) snapshots.push_back(snapshot_json(snap));
+  for (const auto& snap : r.snapshots) {
+    const RunRecord::Snapshot* ref = nullptr;
+    if (sc)
+      for (const auto& rs : sc->reference_snapshots)
+        if (rs.label == snap.label && rs.frame == snap.frame) ref = &rs;
+    snapshots.push_back(snapshot_json(snap, ref));
+  }
 
   nlohmann::json out = {{"scenario", r.scenario},
                        {"model", r.model},
@@ -180,13 +289,15 @@ nlohmann::json run_json(const RunRecord& r) {
                        {"dt", r.dt},
                        {"settle_from", r.settle_from},
                        {"params", r.params},
-                       {"status", r.failure ? "unstable" : "ok"},
+                       {"status", verdict::status_name(r.verdict.status)},
+                       {"verdict", verdict::verdict_json(r.verdict)},
                        {"failure", failure},
                        {"timing", timing},
                        {"metrics", metrics},
                        {"series",
                         {{"t", series(r.t)},
                          {"step_ms", series(r.step_ms)},
+                         {"worked", r.worked},
                          {"deviation_vs_reference", series(r.deviation)},
                          {"jaggedness", series(r.jaggedness)},
                          {"length_error_rms", series(r.length_rms)},
@@ -235,9 +346,16 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
 
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,
                            const std::vector<ScenarioRecord>& scenarios) {
-  nlohmann::json j = {{"schema", "hairbench-report"}, {"schema_version", 1}, {"context", context_json(ctx)}};
+  nlohmann::json j = {{"schema", "hairbench-report"},
+                      {"schema_version", 2},
+                      {"context", context_json(ctx)},
+                      {"snapshot_encoding", kSnapshotEncoding}};
   j["runs"] = nlohmann::json::array();
-  for (const RunRecord& r : runs) j["runs"].push_back(run_json(r));
+  for (const RunRecord& r : runs) {
+    const auto sc = std::find_if(scenarios.begin(), scenarios.end(),
+                                 [&](const ScenarioRecord& s) { return s.name == r.scenario; });
+    j["runs"].push_back(run_json(r, sc == scenarios.end() ? nullptr : &*sc));
+  }
   if (!scenarios.empty()) {
     j["scenarios"] = nlohmann::json::array();
     for (const ScenarioRecord& sc : scenarios) j["scenarios"].push_back(scenario_json(sc));

@@ -1,7 +1,9 @@
-// The hairbench-report JSON (DESIGN.md, "Report (contract)", schema_version 1).
+// The hairbench-report JSON (docs/report-schema.md; schema_version 2: snapshot
+// strands encoded, see encode_snapshot_strand).
 #pragma once
 
 #include "core/types.h"
+#include "reports/verdict.h"
 
 #include <nlohmann/json.hpp>
 
@@ -10,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace hairbench {
@@ -31,11 +34,15 @@ struct RunRecord {
     double t;
     std::string reason;
   };
-  std::optional<Failure> failure;  // set when the model became unstable
+  std::optional<Failure> failure;  // set when the model diverged and the run stopped
+  verdict::Verdict verdict;         // the run's stability class (reports/verdict.h)
 
   std::string reference;  // model the deviation is measured against
   // Per frame actually run (a failed run stops early).
   std::vector<double> step_ms;
+  // Per frame run: 1 where the model worked (the head moved, wind blew, or some strand was
+  // awake), 0 where it skipped every stage because all its strands slept.
+  std::vector<std::uint8_t> worked;
   std::vector<double> gpu_ms;  // device time per step, GPU models with timestamps only
   std::vector<double> deviation;  // NaN where the reference had already failed
   std::vector<double> jaggedness;
@@ -44,11 +51,11 @@ struct RunRecord {
   std::vector<double> penetration;
   std::vector<double> t;  // time at the end of each frame
   std::map<std::string, double> stage_ms_total;  // summed over the run
-  // Steps in which a stage was not needed and not run (issue 8); absent when never.
+  // Steps in which a stage was not needed and not run; absent when never.
   std::map<std::string, std::size_t> stage_skipped_steps;
   std::uint64_t state_hash = 0;
   // The model's state_bytes() and the time to stream them once on the run's threads
-  // (harness/roofline.h), CPU models only: timing.roofline_ratio (issue 10).
+  // (harness/roofline.h), CPU models only: timing.roofline_ratio.
   std::size_t state_bytes = 0;
   double stream_ms = 0.0;
 
@@ -105,14 +112,38 @@ struct ReportContext {
 };
 
 nlohmann::json context_json(const ReportContext& ctx);
-nlohmann::json run_json(const RunRecord& run);
+// With `sc`, the run's snapshots are written relative to the scenario's reference's.
+nlohmann::json run_json(const RunRecord& run, const ScenarioRecord* sc = nullptr);
 nlohmann::json scenario_json(const ScenarioRecord& sc);
 // `scenarios` adds the report's "scenarios" list (phases, snapshot frames); a report
-// without it is still schema version 1.
+// without it is still a complete report.
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,
                            const std::vector<ScenarioRecord>& scenarios = {});
 // Writes pretty JSON, creating the folder; throws std::runtime_error on I/O failure.
 void write_json(const std::filesystem::path& file, const nlohmann::json& j);
+
+// Snapshot strands in the report: positions rounded to 10 micrometres (a drawn pixel
+// of a strand picture is millimetres; the deviations the pictures colour are fractions
+// of L-bar, centimetres), as integers q = round(x / 1e-5 m) in the order x0 y0 z0 x1 ...;
+// with `ref` (a run's snapshot marked "relative_to_reference"), q minus the reference
+// strand's q. Each value is predicted from the same axis of the two vertices before it
+// (2 q[v-1] - q[v-2]; q[v-1] for the second vertex, 0 for the first) and the residual
+// r = q - prediction is zigzag-mapped ((r << 1) ^ (r >> 63)), written as a LEB128 varint
+// (7 bits a byte, low bits first, high bit set while more follow), and the bytes as padded
+// base64 (RFC 4648). A strand with a non-finite or absurd (beyond 1e6 m) position has no
+// code (null).
+inline constexpr double kSnapshotUnitMetres = 1e-5;
+inline constexpr const char* kSnapshotEncoding =
+    "runs[].snapshots[].strands and scenarios[].snapshots.reference.snapshots[].strands: one string per strand "
+    "(null: a non-finite position or one beyond 1e6 m), padded base64 of LEB128 varints; each varint is a "
+    "zigzag-mapped residual r = q - p, q = round(coordinate / 1e-5 m) (minus the reference strand's q at the same "
+    "frame where the snapshot has relative_to_reference: true), coordinates in the order x0 y0 z0 x1 ..., the "
+    "prediction p of a value from the same axis of the vertices before it: 0 for the first vertex, q[v-1] for the "
+    "second, 2 q[v-1] - q[v-2] after";
+std::optional<std::string> encode_snapshot_strand(const std::vector<float>& xyz, const std::vector<float>* ref = nullptr);
+// The inverse, in metres (multiples of 1e-5; `ref` decoded first); throws
+// std::runtime_error on a malformed code.
+std::vector<double> decode_snapshot_strand(std::string_view code, const std::vector<double>* ref = nullptr);
 
 // Summary statistics used by the report (exposed for tests).
 double median(std::vector<double> v);

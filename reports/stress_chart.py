@@ -67,15 +67,18 @@ def main(argv):
     dgrid = [[float("nan")] * max(len(grooms), 1) for _ in models]
     for d in degenerate:
         r, c = models.index(d["model"]), grooms.index(d["groom"])
-        dgrid[r][c] = {"ok": 1.0, "refused": 0.5, "unstable": 0.0}[d["status"]]
+        # the verdict classes (docs/verdicts.md) and "refused" at load; stress.json files
+        # written before the classes existed call a blow-up "unstable" too
+        dgrid[r][c] = {"ok": 1.0, "stretched": 0.75, "refused": 0.5, "unstable": 0.25, "diverged": 0.0}[d["status"]]
         bottom.text(c, r, d["status"], ha="center", va="center", fontsize=6)
-    bottom.imshow(dgrid, cmap=ListedColormap(["#e06666", "#ffd966", "#93c47d"]),
+    bottom.imshow(dgrid, cmap=ListedColormap(["#e06666", "#f6b26b", "#ffd966", "#fff2cc", "#93c47d"]),
                   vmin=0, vmax=1, aspect="auto")
     bottom.set_yticks(range(len(models)))
     bottom.set_yticklabels(models, fontsize=6)
     bottom.set_xticks(range(len(grooms)))
     bottom.set_xticklabels(grooms, fontsize=6)
-    bottom.set_title("Degenerate grooms: ok, refused at load (yellow) or unstable (red)", fontsize=8)
+    bottom.set_title("Degenerate grooms: ok (green), stretched, refused at load (yellow), unstable (orange) "
+                     "or diverged (red)", fontsize=8)
     fig.tight_layout()
     written = []
     for ext in ("png", "svg"):

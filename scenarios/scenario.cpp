@@ -156,7 +156,7 @@ const json& as_object(const Reader& r, const json& j, const std::string& path) {
 }
 
 // One JSON object of the file with the keys it may hold. Construction rejects any other
-// key (DESIGN.md: unknown keys are an error that names the key and the file), so a typo
+// key (docs/scenarios.md: unknown keys are an error that names the key and the file), so a typo
 // such as "frequency" for "frequency_hz" never silently falls back to a default.
 class Obj {
  public:

@@ -1,5 +1,5 @@
 // A scenario: groom + scripted head motion + colliders + wind + per-model parameters
-// (the scenario file contract of DESIGN.md).
+// (the scenario file contract, docs/scenarios.md).
 #pragma once
 
 #include "core/error.h"

@@ -1,5 +1,5 @@
 // Runs the hairbench binary (HAIRBENCH_EXE, set by the test's CMake target) and captures
-// its exit code and combined output.
+// its exit code and output.
 #pragma once
 
 #include <cstdio>
@@ -13,9 +13,10 @@ struct CliResult {
   std::string out;
 };
 
-// `env` is prepended to the command line ("NAME=VALUE ...").
-inline CliResult run_cli(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + "\"" + HAIRBENCH_EXE + "\" " + args + " 2>&1";
+// `env` is prepended to the command line ("NAME=VALUE ..."); `streams` says what `out`
+// captures: both streams by default, standard output alone with "2>/dev/null".
+inline CliResult run_cli(const std::string& args, const std::string& env = "", const std::string& streams = "2>&1") {
+  const std::string cmd = env + "\"" + HAIRBENCH_EXE + "\" " + args + " " + streams;
   CliResult r{-1, {}};
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;

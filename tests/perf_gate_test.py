@@ -119,7 +119,7 @@ class AccuracyDecisions(unittest.TestCase):
 
     def test_newly_unstable_fails(self):
         self.assertEqual(self.verdicts([run("m")], [run("m", status="unstable")]),
-                         ["REGRESSION (unstable)"])
+                         ["REGRESSION (no longer ok)"])
 
     def test_not_a_report_is_an_input_error(self):
         with self.assertRaises(perf_gate.GateError):

@@ -1,4 +1,4 @@
-// `hairbench reproduce` (issue 9): bad arguments are one-line errors with exit code 2;
+// `hairbench reproduce`: bad arguments are one-line errors with exit code 2;
 // a quick run of one table writes the report's three files, and every verdict in it
 // follows from the measured value and the stated bounds.
 #include "harness/reproduce.h"

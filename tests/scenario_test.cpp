@@ -1,4 +1,4 @@
-// Scenario layer: the loader's contract (DESIGN.md "Scenario file"), the shipped
+// Scenario layer: the loader's contract (docs/scenarios.md), the shipped
 // scenarios, the procedural grooms and the head-motion script.
 #include "scenario_support.h"
 #include "scenarios/scenario.h"

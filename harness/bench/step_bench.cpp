@@ -127,7 +127,7 @@ void bm_step(benchmark::State& state, const ModelInfo* info, const Scenario* sc,
   // descheduled inflates the mean, never the minimum.
   state.counters["min_ms"] = min_s * 1e3;
   state.counters["roofline_ratio_min"] = min_s / stream;
-  if (!stable) state.SetLabel("unstable");
+  if (!stable) state.SetLabel("diverged");
 }
 
 void bm_roofline_stream(benchmark::State& state) {

@@ -1,4 +1,4 @@
-// Parameters of Han & Harada 2012 methods 1-3 (names are the DESIGN.md contract).
+// Parameters of Han & Harada 2012 methods 1-3 (names are a contract: docs/scenarios.md).
 //
 // Defaults are chosen for real gravity (9.81 m/s^2, strands in metres) at 60 Hz frames.
 // TressFX's sample values (damping 0.1, S_L 0.5, S_G 0.2 over 30% of the strand) with

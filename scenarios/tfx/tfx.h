@@ -50,7 +50,7 @@ void write_tfx_v4(const std::filesystem::path& file, const Groom& groom);
 
 // ---- .tfxsim / .tfxproj ---------------------------------------------------------------
 
-// Simulation settings with hairbench parameter names (DESIGN.md, "Parameter names"):
+// Simulation settings with hairbench parameter names (docs/scenarios.md):
 // damping, local_stiffness, global_stiffness, global_range, length_iterations,
 // local_iterations. Only the keys present in the file are set.
 struct SimSettings {

@@ -150,7 +150,7 @@ class Reader {
 // counts far inside int.
 constexpr double kMaxIterations = 1000.0;
 
-// TressFX key -> hairbench parameter name (DESIGN.md, "Parameter names").
+// TressFX key -> hairbench parameter name (docs/scenarios.md).
 struct KeyName {
   std::string_view tressfx;
   std::string_view hairbench;

@@ -1,0 +1,133 @@
+#include "reports/verdict.h"
+
+#include <cmath>
+
+namespace hairbench::verdict {
+
+std::string_view status_name(Status s) {
+  switch (s) {
+    case Status::ok: return "ok";
+    case Status::stretched: return "stretched";
+    case Status::unstable: return "unstable";
+    case Status::diverged: return "diverged";
+  }
+  return "ok";
+}
+
+void StretchTracker::add(int frame, const metrics::LengthError& e) {
+  if (!(e.max <= kStretchLimit)) ++s_.frames_above;  // NaN counts: the edge is not within the limit
+  if (e.max > s_.peak || (s_.peak_frame < 0 && std::isfinite(e.max))) {
+    s_.peak = e.max;
+    s_.peak_frame = frame;
+    s_.worst_strand = e.worst_strand;
+    s_.worst_edge = e.worst_edge;
+  }
+}
+
+void SettleCheck::add(double t, double energy, bool driven, double settle_from) {
+  if (driven || t < settle_from - 1e-9) return;
+  t_.push_back(t);
+  e_.push_back(energy);
+}
+
+Settle SettleCheck::result() const {
+  Settle s;
+  s.frames = static_cast<int>(e_.size());
+  if (s.frames < kMinFrames) return s;
+  const std::size_t half = e_.size() / 2;
+  auto mean = [](const std::vector<double>& v, std::size_t b, std::size_t e) {
+    double sum = 0.0;
+    for (std::size_t i = b; i < e; ++i) sum += v[i];
+    return sum / static_cast<double>(e - b);
+  };
+  s.energy_first = mean(e_, 0, half);
+  s.energy_second = mean(e_, e_.size() - half, e_.size());
+  const double span = mean(t_, e_.size() - half, e_.size()) - mean(t_, 0, half);
+  s.rate = std::log(s.energy_second / s.energy_first) / span;
+  const double floor = 0.5 * kRestSpeed * kRestSpeed;
+  // NaN energy (a non-finite state) fails the comparisons and so counts as not decaying.
+  s.decays = s.energy_second < floor || s.rate <= -kMinDecayRate;
+  return s;
+}
+
+double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, const Affine3f& head,
+                               const Affine3f& head_prev, double dt) {
+  // Hair carried rigidly by the head scores 0, so a walk's steady translation is not
+  // motion of the hair; a whip is.
+  const Affine3f carry = head * head_prev.inverse();
+  double sum = 0.0;
+  for (std::size_t v = 0; v < p.size(); ++v) {
+    const Vec3f d = p[v].head<3>() - carry * Vec3f(prev[v].head<3>());
+    sum += static_cast<double>(d.squaredNorm());
+  }
+  return p.empty() ? 0.0 : sum / (2.0 * dt * dt * static_cast<double>(p.size()));
+}
+
+Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::string& diverged, const Stretch& stretch,
+               const Settle& settle, const Probe& probe, double dt) {
+  Verdict v;
+  v.stretch = stretch;
+  v.settle = settle;
+  v.probe = probe;
+  char buf[160];
+  if (stop) {
+    v.status = Status::diverged;
+    v.reason = diverged;
+    v.frame = stop->first;
+    v.t = stop->second;
+  } else if (probe.run && probe.grows) {
+    v.status = Status::unstable;
+    std::snprintf(buf, sizeof buf, "a perturbation at rest grows at %.3g/s (%.2g -> %.2g mean strand lengths)",
+                  probe.rate, probe.kick, probe.last);
+    v.reason = buf;
+  } else if (!settle.decays) {
+    v.status = Status::unstable;
+    std::snprintf(buf, sizeof buf,
+                  "motion does not decay with the head still: kinetic energy %.3g -> %.3g m^2/s^2 (%.3g/s)",
+                  settle.energy_first, settle.energy_second, settle.rate);
+    v.reason = buf;
+  } else if (stretch.frames_above > 0) {
+    v.status = Status::stretched;
+    std::snprintf(buf, sizeof buf, "edge length error %.3g (strand %u, edge %u) above %.2g in %d frames",
+                  stretch.peak, stretch.worst_strand, stretch.worst_edge, kStretchLimit, stretch.frames_above);
+    v.reason = buf;
+    v.frame = stretch.peak_frame;
+    v.t = (stretch.peak_frame + 1) * dt;
+  }
+  return v;
+}
+
+namespace {
+nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+}  // namespace
+
+nlohmann::json verdict_json(const Verdict& v) {
+  nlohmann::json j = {{"class", status_name(v.status)},
+                      {"reason", v.reason},
+                      {"frame", v.frame >= 0 ? nlohmann::json(v.frame) : nlohmann::json(nullptr)},
+                      {"t", v.frame >= 0 ? num(v.t) : nlohmann::json(nullptr)},
+                      {"stretch",
+                       {{"limit", kStretchLimit},
+                        {"peak", num(v.stretch.peak)},
+                        {"peak_frame", v.stretch.peak_frame},
+                        {"worst_strand", v.stretch.worst_strand},
+                        {"worst_edge", v.stretch.worst_edge},
+                        {"frames_above", v.stretch.frames_above}}},
+                      {"settle",
+                       {{"frames", v.settle.frames},
+                        {"energy_first", num(v.settle.energy_first)},
+                        {"energy_second", num(v.settle.energy_second)},
+                        {"rate", num(v.settle.rate)},
+                        {"decays", v.settle.decays}}}};
+  if (v.probe.run)
+    j["probe"] = {{"kick", num(v.probe.kick)},
+                  {"first", num(v.probe.first)},
+                  {"last", num(v.probe.last)},
+                  {"growth_rate", num(v.probe.rate)},
+                  {"grows", v.probe.grows}};
+  else
+    j["probe"] = {{"skipped", v.probe.skipped_why}};
+  return j;
+}
+
+}  // namespace hairbench::verdict

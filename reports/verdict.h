@@ -1,0 +1,125 @@
+// Stability verdicts: what a run's motion says about the model, in four classes
+// (docs/verdicts.md). Each class has one detector here, fed frame by frame by the runner;
+// the detectors read positions only, so every model is judged by the same code.
+//
+//   diverged   NaN/Inf, a vertex beyond the blow-up distance, or mechanical energy
+//              growing with nothing driving the hair: the run stops there.
+//   unstable   self-excited motion: with the head still and no wind, motion relative to
+//              the head that does not decay (SettleCheck), or a tiny perturbation at rest
+//              that grows (the probe, harness/probe.h). The run goes on and is measured.
+//   stretched  a constraint violated: some edge more than kStretchLimit longer or shorter
+//              than at rest (StretchTracker). Measured, never a reason to stop.
+//   ok         none of these.
+#pragma once
+
+#include "core/types.h"
+#include "reports/metrics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hairbench::verdict {
+
+enum class Status { ok, stretched, unstable, diverged };
+std::string_view status_name(Status s);
+
+// An edge error (metrics::length_error: relative to the strand's median rest edge) above
+// this is a stretched frame: half an edge length, far beyond what a converging
+// constraint solver leaves and well before a strand looks broken.
+inline constexpr double kStretchLimit = 0.5;
+
+struct Stretch {
+  double peak = 0.0;        // largest edge error of any frame
+  int peak_frame = -1;
+  std::uint32_t worst_strand = 0, worst_edge = 0;  // where the peak was
+  int frames_above = 0;     // frames whose largest edge error exceeds kStretchLimit
+};
+
+class StretchTracker {
+ public:
+  void add(int frame, const metrics::LengthError& e);
+  const Stretch& result() const { return s_; }
+
+ private:
+  Stretch s_;
+};
+
+// Motion that does not die out with nothing driving it. Over the frames at or after the
+// scenario's settle time (the motion has ended at least a second earlier) during which
+// the head holds still and no wind blows, the kinetic energy per unit mass relative to
+// the head, mean |p - H H_prev^-1 p_prev|^2 / (2 dt^2), is averaged over the first and
+// the second half of those frames, and its rate ln(second / first) / (time between the
+// halves' centres) taken. The motion has not decayed when that rate is above
+// -kMinDecayRate while the second half stays above the floor of hair at rest (every
+// vertex slower than kRestSpeed): it grows, or holds a limit cycle (contact chatter, a
+// self-excited flutter). The window is about a second, too short to tell a limit cycle
+// from a decay much slower than kMinDecayRate; a damped model's energy falls faster
+// than that by orders of magnitude (a velocity damping of 0.1 per substep at six
+// substeps and 60 Hz removes energy at about 76/s).
+struct Settle {
+  int frames = 0;                                          // still frames after settle_from
+  double energy_first = std::numeric_limits<double>::quiet_NaN();   // m^2/s^2, first half's mean
+  double energy_second = std::numeric_limits<double>::quiet_NaN();  // second half's mean
+  // ln(energy_second / energy_first) / (time between the halves' centres), 1/s: < 0 decays.
+  double rate = std::numeric_limits<double>::quiet_NaN();
+  bool decays = true;
+};
+
+class SettleCheck {
+ public:
+  // Energy that takes longer than 10 s to fall by a factor e has not decayed.
+  static constexpr double kMinDecayRate = 0.1;
+  // 1 mm/s: 1/100 of a strand length of 10 cm per second, invisible at 60 Hz.
+  static constexpr double kRestSpeed = 1e-3;
+  static constexpr int kMinFrames = 20;  // fewer still frames than this: no verdict
+
+  // One frame's relative kinetic energy; counted when the frame ends at or after
+  // settle_from and nothing drove the hair during it.
+  void add(double t, double energy, bool driven, double settle_from);
+  Settle result() const;
+
+ private:
+  std::vector<double> t_, e_;
+};
+
+// Kinetic energy per unit mass relative to the head between two frames (see Settle).
+double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, const Affine3f& head,
+                               const Affine3f& head_prev, double dt);
+
+// The seeded perturbation probe at rest (harness/probe.h): growth of the distance
+// between a run kicked by a tiny head pulse and its unkicked twin.
+struct Probe {
+  bool run = false;
+  std::string skipped_why;  // when not run
+  double kick = 0.0;        // RMS distance right after the pulse, in mean strand lengths
+  double first = 0.0, last = 0.0;  // its mean over the first and the last kWindow frames after that
+  double rate = 0.0;        // ln(last / kick) / time from the kick to the last window's centre, 1/s
+  bool grows = false;
+};
+
+// The verdict of one run.
+struct Verdict {
+  Status status = Status::ok;
+  std::string reason;  // empty for ok
+  int frame = -1;      // where it was decided (diverged: the frame it stopped; stretched: the peak)
+  double t = 0.0;
+  Stretch stretch;
+  Settle settle;
+  Probe probe;
+};
+
+// Combines the detectors: the worst class wins (diverged > unstable > stretched > ok).
+// `diverged` is the blow-up reason when the run stopped, with its frame and time.
+Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::string& diverged, const Stretch& stretch,
+               const Settle& settle, const Probe& probe, double dt);
+
+nlohmann::json verdict_json(const Verdict& v);
+
+}  // namespace hairbench::verdict

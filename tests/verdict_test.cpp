@@ -1,0 +1,176 @@
+// The stability verdicts (reports/verdict.h, harness/probe.h): each detector on series
+// whose answer is known, their precedence, and the probe on a rest state that physics
+// says is stable (Han's method 1, Halén's spring) against one the cascade's reference
+// springs make unstable at 16 nodes.
+#include "core/parallel.h"
+#include "harness/probe.h"
+#include "harness/runner.h"
+#include "models/registry.h"
+#include "reports/verdict.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+using namespace hairbench;
+using verdict::Status;
+
+namespace {
+
+constexpr double kDt = 1.0 / 60.0;
+
+// Kinetic energy e(t) on every frame of a 2 s still window after settle_from = 0.
+verdict::Settle settle_of(const std::function<double(double)>& e) {
+  verdict::SettleCheck c;
+  for (int f = 0; f < 120; ++f) c.add((f + 1) * kDt, e((f + 1) * kDt), false, 0.0);
+  return c.result();
+}
+
+TEST(SettleCheck, DampedMotionDecaysAndAFlutterDoesNot) {
+  // A damped swing: energy e-folds in 0.5 s, far above the rest floor.
+  const verdict::Settle damped = settle_of([](double t) { return 0.1 * std::exp(-2.0 * t); });
+  EXPECT_TRUE(damped.decays);
+  EXPECT_NEAR(damped.rate, -2.0, 1e-9);
+  // A limit cycle: the energy oscillates but its half-window means hold.
+  const verdict::Settle cycle =
+      settle_of([](double t) { return 0.01 * (1.0 + std::sin(2.0 * M_PI * 3.0 * t)); });
+  EXPECT_FALSE(cycle.decays);
+  // Growth.
+  const verdict::Settle grows = settle_of([](double t) { return 1e-4 * std::exp(3.0 * t); });
+  EXPECT_FALSE(grows.decays);
+  EXPECT_GT(grows.rate, 2.9);
+  // Hair at rest: energy far below the floor of every vertex at kRestSpeed holds or even
+  // rises (rounding) and still counts as at rest.
+  const double floor = 0.5 * verdict::SettleCheck::kRestSpeed * verdict::SettleCheck::kRestSpeed;
+  EXPECT_TRUE(settle_of([&](double t) { return 1e-3 * floor * (1.0 + t); }).decays);
+  // NaN energy is not decay.
+  EXPECT_FALSE(settle_of([](double) { return std::nan(""); }).decays);
+}
+
+TEST(SettleCheck, CountsOnlyStillFramesAfterTheSettleTime) {
+  verdict::SettleCheck c;
+  for (int f = 0; f < 120; ++f) {
+    const double t = (f + 1) * kDt;
+    // Driven (energetic) frames and frames before settle_from must not count.
+    c.add(t, 1.0, /*driven=*/f < 60, /*settle_from=*/0.5);
+  }
+  EXPECT_EQ(c.result().frames, 60);
+  verdict::SettleCheck few;
+  for (int f = 0; f < verdict::SettleCheck::kMinFrames - 1; ++f) few.add(f * kDt, 1.0, false, 0.0);
+  EXPECT_TRUE(few.result().decays);  // too few frames for a verdict
+}
+
+TEST(StretchTracker, PeakWorstStrandAndFramesAbove) {
+  verdict::StretchTracker s;
+  s.add(0, {0.01, 0.1, 3, 2});
+  s.add(1, {0.2, 0.9, 7, 5});
+  s.add(2, {0.1, 0.6, 1, 1});
+  s.add(3, {0.01, 0.2, 0, 1});
+  const verdict::Stretch& r = s.result();
+  EXPECT_EQ(r.peak, 0.9);
+  EXPECT_EQ(r.peak_frame, 1);
+  EXPECT_EQ(r.worst_strand, 7u);
+  EXPECT_EQ(r.worst_edge, 5u);
+  EXPECT_EQ(r.frames_above, 2);
+}
+
+TEST(Verdict, TheWorstClassWins) {
+  verdict::Stretch stretched;
+  stretched.frames_above = 3;
+  stretched.peak = 0.7;
+  stretched.peak_frame = 9;
+  verdict::Settle flutter;
+  flutter.decays = false;
+  verdict::Probe grows;
+  grows.run = grows.grows = true;
+  grows.rate = 7.0;
+  EXPECT_EQ(verdict::decide({}, "", {}, {}, {}, kDt).status, Status::ok);
+  const verdict::Verdict s = verdict::decide({}, "", stretched, {}, {}, kDt);
+  EXPECT_EQ(s.status, Status::stretched);
+  EXPECT_EQ(s.frame, 9);
+  EXPECT_NE(s.reason.find("0.7"), std::string::npos) << s.reason;
+  EXPECT_EQ(verdict::decide({}, "", stretched, flutter, {}, kDt).status, Status::unstable);
+  const verdict::Verdict u = verdict::decide({}, "", stretched, {}, grows, kDt);
+  EXPECT_EQ(u.status, Status::unstable);
+  EXPECT_NE(u.reason.find("grows at 7/s"), std::string::npos) << u.reason;
+  const verdict::Verdict d = verdict::decide(std::make_pair(4, 5 * kDt), "non-finite position", stretched, flutter,
+                                             grows, kDt);
+  EXPECT_EQ(d.status, Status::diverged);
+  EXPECT_EQ(d.frame, 4);
+  EXPECT_EQ(d.reason, "non-finite position");
+  EXPECT_EQ(verdict::verdict_json(d)["class"], "diverged");
+}
+
+// `idle` with `vertices` per strand and 48 strands.
+Scenario idle_with(int vertices) {
+  const fs::path dir = fs::temp_directory_path() / "hairbench_verdict";
+  fs::create_directories(dir);
+  const fs::path file = dir / ("idle_" + std::to_string(vertices) + ".json");
+  std::ofstream(file) << R"({ "frames": 180, "dt": 0.016666666666666666, "gravity": [0, -9.81, 0],
+    "groom": { "style": "straight", "strands": 48, "vertices_per_strand": )"
+                      << vertices << R"(, "length": 0.25, "seed": 1 },
+    "head": { "radius": 0.1 },
+    "colliders": [ { "type": "sphere", "center": [0, 0, 0], "radius": 0.1, "attached": "head" } ],
+    "settle_from": 2.0 })";
+  return load_scenario(file);
+}
+
+verdict::Probe probe(const std::string& model, const Scenario& sc) {
+  ThreadPool pool(2);
+  const ModelInfo* info = find_model(model);
+  return perturbation_probe(*info, sc, resolve_params(*info, sc, {}), pool);
+}
+
+TEST(Probe, StableRestStatesDampTheKick) {
+  const Scenario sc = idle_with(16);
+  for (const char* model : {"han_m1", "han_m3", "halen_spring"}) {
+    SCOPED_TRACE(model);
+    const verdict::Probe p = probe(model, sc);
+    ASSERT_TRUE(p.run);
+    EXPECT_FALSE(p.grows) << p.rate;
+    EXPECT_LT(p.rate, ProbeSettings::kMinGrowthRate);
+    // The kick is about the probe's amplitude: far below anything visible.
+    EXPECT_GT(p.kick, 0.0);
+    EXPECT_LT(p.kick, 1e-4);
+  }
+}
+
+// The same probe finds the cascade's rest state at 16 nodes unstable: the reference
+// springs push each node towards an extrapolation of the two above it without a reaction
+// on those, which feeds a disturbance down the strand.
+TEST(Probe, CascadeAtSixteenNodesGrows) {
+  const verdict::Probe p = probe("halen_cascade", idle_with(16));
+  ASSERT_TRUE(p.run);
+  EXPECT_TRUE(p.grows);
+  EXPECT_GT(p.rate, ProbeSettings::kMinGrowthRate);
+  EXPECT_GT(p.last, ProbeSettings::kMinGrowth * ProbeSettings::kAmplitude);
+}
+
+// In the lockstep run: the cascade's unstable rest state is the run's verdict whether or
+// not strands may sleep, and sleeping (off for a model whose probe grows) changes no
+// metric of it.
+TEST(Verdict, CascadeOnIdleIsUnstableWithAndWithoutSkipping) {
+  const Scenario sc = idle_with(16);
+  ThreadPool pool(2);
+  std::vector<RunRecord> runs[2];
+  for (int skip = 0; skip < 2; ++skip) {
+    RunOptions opt;
+    opt.models = {"halen_cascade", "han_m1"};
+    opt.skip_inert = skip == 1;
+    runs[skip] = run_scenario(sc, opt, pool);
+  }
+  for (int skip = 0; skip < 2; ++skip) {
+    const RunRecord& c = test::find(runs[skip], "halen_cascade");
+    EXPECT_EQ(c.verdict.status, Status::unstable) << c.verdict.reason;
+    EXPECT_GT(c.verdict.probe.rate, ProbeSettings::kMinGrowthRate);
+    const RunRecord& m1 = test::find(runs[skip], "han_m1");
+    EXPECT_EQ(m1.verdict.status, Status::ok) << m1.verdict.reason;
+  }
+  EXPECT_EQ(test::find(runs[0], "halen_cascade").state_hash, test::find(runs[1], "halen_cascade").state_hash);
+}
+
+}  // namespace
