@@ -63,7 +63,8 @@ constexpr const char* kStressHelp =
     "stress escalates one axis at a time (time step, head angular\n"
     "velocity and acceleration, teleports, strand vertices and\n"
     "length, every stiffness, iteration count and damping) from\n"
-    "the stable base scenario until each CPU model fails, runs\n"
+    "the stable base scenario until each CPU model's verdict is\n"
+    "no longer ok (stretched, unstable or diverged), runs\n"
     "degenerate grooms, prints the table, writes DIR/stress.json\n"
     "and draws its heatmap DIR/stress_heatmap.png.";
 
@@ -387,6 +388,13 @@ CLI::Validator whole_number(long long lo, long long hi) {
       "");
 }
 
+// --threads, the same for every subcommand that runs models.
+void add_threads_option(CLI::App& sub, int& threads) {
+  sub.add_option("--threads", threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
+      ->type_name("N")
+      ->check(whole_number(1, 1024));
+}
+
 // The options compare and sweep share; sweep adds --knob and needs --scenario.
 void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
   a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
@@ -414,9 +422,7 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
   sub.add_option("--frames", a.run.frames, "frames per run, 1 to 10000000 (default: the scenario's)")
       ->type_name("N")
       ->check(whole_number(1, 10'000'000));
-  sub.add_option("--threads", a.threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
-      ->type_name("N")
-      ->check(whole_number(1, 1024));
+  add_threads_option(sub, a.threads);
   sub.add_option("--set", a.sets, "parameter override; MODEL may be * for every model that\nhas NAME; repeatable")
       ->type_name("MODEL.NAME=VALUE")
       ->allow_extra_args(false);
@@ -443,9 +449,7 @@ void add_stress_options(CLI::App& sub, StressArgs& a) {
       ->check(whole_number(1, 1'000'000))
       ->capture_default_str();
   sub.add_flag_callback("--quick", [&a] { a.opt.value_stride = 2; }, "try every other value of each axis");
-  sub.add_option("--threads", a.threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
-      ->type_name("N")
-      ->check(whole_number(1, 1024));
+  add_threads_option(sub, a.threads);
   sub.add_option("--out", a.out, "the report's directory")->type_name("DIR")->capture_default_str();
   sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write stress.json only, no heatmap");
 }
@@ -456,9 +460,7 @@ void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, Repr
   sub.add_option("--frames", o.frames, "cap every run at N frames (quick runs), 1 to 1000000")
       ->type_name("N")
       ->check(whole_number(1, 1'000'000));
-  sub.add_option("--threads", o.threads, "worker threads, 1 to 1024 (default: one per hardware\nthread)")
-      ->type_name("N")
-      ->check(whole_number(1, 1024));
+  add_threads_option(sub, o.threads);
   sub.add_option("--device", o.device, "Vulkan device for Han & Harada's GPU table, by index or\nname")
       ->type_name("NAME|INDEX");
   sub.add_option("--out", o.out, "the report's directory")->type_name("DIR")->capture_default_str();
