@@ -291,11 +291,8 @@ json reproduce_han(const Ctx& c) {
       l.jag_sum += metrics::jaggedness(rest, p);
       const double d = metrics::deviation(p, p1, rest.mean_strand_length);
       l.dev2 += d * d;
-      for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) {
-        const std::size_t b = sc.groom.strand_begin(s), n = sc.groom.strand_size(s);
-        const double j = metrics::strand_jaggedness(p.subspan(b, n), std::span(rest.rest_kb_change).subspan(b, n));
-        l.strand_peak[s] = std::max(l.strand_peak[s], j);
-      }
+      for (std::size_t s = 0; s < sc.groom.strand_count(); ++s)
+        l.strand_peak[s] = std::max(l.strand_peak[s], metrics::strand_jaggedness(rest, p, s));
     }
   }
   std::map<std::string, double> jag, dev;

@@ -103,6 +103,7 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
       edge_count(0),
       mean_strand_length(hairbench::mean_strand_length(rest)),
       rest_kb_change(rest.vertex_count(), 0.0),
+      kb_weight(rest.vertex_count(), 1.0),
       head_extent(0.0),
       simulated_strands(std::min(simulated, rest.strand_count())) {
   // The fallback scale: the mean rest edge of the simulated strands (of all strands if
@@ -132,6 +133,11 @@ RestInfo::RestInfo(const Groom& rest, std::size_t simulated)
     const double median = n > 1 ? median_edge(rest_length.data() + b + 1, n - 1, buf) : 0.0;
     edge_scale[s] = median > 1e-6 * mean_edge ? median : mean_edge;
     std::fill_n(vertex_edge_scale.begin() + static_cast<std::ptrdiff_t>(b), n, edge_scale[s]);
+    // The pair at vertex b + i reads kb at i - 1 and i: the edges ending at i - 1, i, i + 1.
+    const double shortest = kMinTurnEdge * edge_scale[s];
+    for (std::size_t i = 2; i + 1 < n; ++i)
+      if (rest_length[b + i - 1] < shortest || rest_length[b + i] < shortest || rest_length[b + i + 1] < shortest)
+        kb_weight[b + i] = 0.0;
   }
   group_for_lanes(rest, jagged_grouped, jagged_alone);
 }
@@ -179,15 +185,22 @@ void strand_kb_changes(std::span<const Vec4f> s, std::span<double> out) {
   for_kb_changes(s, [&](std::size_t i, double d) { out[i] = d; });
 }
 
-double strand_jaggedness(std::span<const Vec4f> s, std::span<const double> rest_kb_change) {
+double strand_jaggedness(std::span<const Vec4f> s, std::span<const double> rest_kb_change,
+                         std::span<const double> kb_weight) {
   const std::size_t n = s.size();
   if (n < 4) return 0.0;
   double sum = 0.0;
   for_kb_changes(s, [&](std::size_t i, double d) {
-    const double diff = d - rest_kb_change[i];
+    const double diff = (d - rest_kb_change[i]) * kb_weight[i];
     sum += diff * diff;
   });
   return std::sqrt(sum / static_cast<double>(n - 3));
+}
+
+double strand_jaggedness(const RestInfo& rest, std::span<const Vec4f> p, std::size_t s) {
+  const std::size_t b = rest.groom->strand_begin(s), n = rest.groom->strand_size(s);
+  return strand_jaggedness(p.subspan(b, n), std::span(rest.rest_kb_change).subspan(b, n),
+                           std::span(rest.kb_weight).subspan(b, n));
 }
 
 namespace {
@@ -248,11 +261,11 @@ METRIC_INLINE void lane_binormals(const LaneEdges& e0, const LaneEdges& e1, Lane
   kb[2] = 2.0 * (e0.x * e1.y - e0.y * e1.x) / denom;
 }
 
-METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const double* rest_kb_change, const std::size_t* begin,
-                                   std::size_t n, double* out) {
+METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const double* rest_kb_change, const double* kb_weight,
+                                   const std::size_t* begin, std::size_t n, double* out) {
   LanePoints a, b;  // vertices i and i + 1
   LaneEdges e0, e1;
-  LaneVec prev[3], kb[3], sum{}, d, d0{};
+  LaneVec prev[3], kb[3], sum{}, d, d0{}, w{};
   lane_points(p, begin, 0, a);
   lane_points(p, begin, 1, b);
   lane_edges(a, b, e0);
@@ -267,8 +280,11 @@ METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const double* rest_
     lane_binormals(e0, e1, kb);
     const LaneVec dx = kb[0] - prev[0], dy = kb[1] - prev[1], dz = kb[2] - prev[2];
     lane_sqrt((dx * dx + dy * dy) + dz * dz, d);
-    for (int l = 0; l < kLanes; ++l) d0[l] = rest_kb_change[begin[l] + i];
-    const LaneVec diff = d - d0;
+    for (int l = 0; l < kLanes; ++l) {
+      d0[l] = rest_kb_change[begin[l] + i];
+      w[l] = kb_weight[begin[l] + i];
+    }
+    const LaneVec diff = (d - d0) * w;
     sum += diff * diff;
     prev[0] = kb[0];
     prev[1] = kb[1];
@@ -295,13 +311,10 @@ METRIC_CLONES double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) 
     std::size_t begin[kLanes];
     double out[kLanes];
     for (int l = 0; l < kLanes; ++l) begin[l] = g.strand_begin(grouped[k + l]);
-    lane_jaggedness(p, rest.rest_kb_change.data(), begin, g.strand_size(grouped[k]), out);
+    lane_jaggedness(p, rest.rest_kb_change.data(), rest.kb_weight.data(), begin, g.strand_size(grouped[k]), out);
     for (int l = 0; l < kLanes; ++l) per_strand[grouped[k + l]] = out[l];
   }
-  for (const std::uint32_t s : rest.jagged_alone) {
-    const std::size_t b = g.strand_begin(s), n = g.strand_size(s);
-    per_strand[s] = strand_jaggedness(p.subspan(b, n), std::span(rest.rest_kb_change).subspan(b, n));
-  }
+  for (const std::uint32_t s : rest.jagged_alone) per_strand[s] = strand_jaggedness(rest, p, s);
   double sum = 0.0;
   for (std::size_t s = 0; s < strands; ++s) sum += per_strand[s];
   return sum / static_cast<double>(strands);

@@ -31,6 +31,12 @@ struct RestInfo {
   // d0, the |kb_{i+1} - kb_i| of the rest shape (strand_kb_changes): per vertex, indexed
   // as strand_kb_changes writes them.
   std::vector<double> rest_kb_change;
+  // Per vertex, indexed as rest_kb_change: 1 for a pair that counts in jaggedness, 0 for
+  // one that reads a rest edge shorter than kMinTurnEdge of its strand's edge_scale. Such
+  // an edge (exporters write 2.4e-7 m ones) has no direction of its own: moving the
+  // strand rounds its ends by about 1e-7 m and turns it by order 1 radian, so a turning
+  // angle across it is rounding, not a kink.
+  std::vector<double> kb_weight;
   // The strands jaggedness computes several at a time (one size >= 4, in groups of its
   // lane count, metrics.cpp), and the others, one at a time; each in index order.
   std::vector<std::uint32_t> jagged_grouped, jagged_alone;
@@ -54,12 +60,17 @@ double deviation(std::span<const Vec4f> p, std::span<const Vec4f> ref, double me
 // vertex (d ~ 2|kb|): the metric reads new changes of curvature, not curvature, and a
 // styled wave or curl flattened out scores above 0 like any other departure from rest.
 
+inline constexpr double kMinTurnEdge = 1e-3;
+
 // d_i of one strand, written to out[i + 1] (the vertex of kb_{i+1}) for i = 1 .. n-3;
 // out[0], out[1] and out[n-1] are left as they are. out.size() == strand.size().
 void strand_kb_changes(std::span<const Vec4f> strand, std::span<double> out);
-// J_s of one strand, with rest_kb_change its strand's span of RestInfo::rest_kb_change
-// (indexed as strand_kb_changes writes them).
-double strand_jaggedness(std::span<const Vec4f> strand, std::span<const double> rest_kb_change);
+// J_s of one strand, with rest_kb_change and kb_weight its strand's spans of RestInfo's
+// (indexed as strand_kb_changes writes them): each term (d_i - d0_i) is weighted.
+double strand_jaggedness(std::span<const Vec4f> strand, std::span<const double> rest_kb_change,
+                         std::span<const double> kb_weight);
+// J_s of strand s of the positions p (the whole groom's).
+double strand_jaggedness(const RestInfo& rest, std::span<const Vec4f> p, std::size_t s);
 // Groom jaggedness: mean over strands of strand_jaggedness.
 double jaggedness(const RestInfo& rest, std::span<const Vec4f> p);
 
