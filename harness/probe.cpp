@@ -2,21 +2,11 @@
 
 #include "core/groom.h"
 #include "core/parallel.h"
+#include "reports/metrics.h"
 
 #include <cmath>
 
 namespace hairbench {
-
-namespace {
-
-double distance(std::span<const Vec4f> a, std::span<const Vec4f> b, double mean_length) {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    sum += static_cast<double>((a[i].head<3>() - b[i].head<3>()).squaredNorm());
-  return a.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(a.size())) / mean_length;
-}
-
-}  // namespace
 
 verdict::Probe perturbation_probe(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
                                   ThreadPool& pool, const std::string& device) {
@@ -28,11 +18,12 @@ verdict::Probe perturbation_probe(const ModelInfo& info, const Scenario& sc, con
 
   ModelContext ctx{&pool, device};
   ctx.skip_inert = false;
-  std::unique_ptr<HairModel> still = info.make(ctx), kicked = info.make(ctx);
+  std::unique_ptr<HairModel> still = info.make(ctx);
   if (still->backend().name != "cpu") {
     out.skipped_why = "runs on a GPU: its CPU implementation of the same method carries the probe";
     return out;
   }
+  std::unique_ptr<HairModel> kicked = info.make(ctx);
   still->reset(groom, params);
   kicked->reset(groom, params);
 
@@ -64,7 +55,7 @@ verdict::Probe perturbation_probe(const ModelInfo& info, const Scenario& sc, con
     if (k == 1) in.head_prev = pulse;
     kicked->step(in, times);
     times.clear();
-    if (k >= 1) d.push_back(distance(still->positions(), kicked->positions(), mean_length));
+    if (k >= 1) d.push_back(metrics::deviation(kicked->positions(), still->positions(), mean_length));
   }
   auto mean = [](const double* v, int n) {
     double s = 0.0;

@@ -25,8 +25,7 @@
 namespace hairbench {
 namespace {
 
-const std::vector<std::string> kCpuModels = {"han_m1",        "han_m2",       "han_m3",     "halen_spring",
-                                             "halen_cascade", "halen_forest", "plante_wisp"};
+using test::kCpuModels;
 constexpr int kFrames = 36;
 constexpr float kTinyEdge = 2.4e-7f;
 

@@ -22,8 +22,7 @@ namespace {
 // Every CPU model. The position-based ones skip passes; the forest and the wisps only
 // skip their body pass, and must come out identical all the same. All of them sleep
 // (plante_wisp as a whole: its wisps touch each other).
-const std::vector<std::string> kCpuModels = {"han_m1",       "han_m2",        "han_m3",     "halen_spring",
-                                             "halen_cascade", "halen_forest", "plante_wisp"};
+using test::kCpuModels;
 const std::vector<std::string> kSleepers = kCpuModels;
 
 // Seconds of `idle` by which a model's hair has settled below StrandSleep::kRestSpeed for

@@ -67,5 +67,8 @@ inline double rms_of(const std::vector<double>& v) {
 }
 
 inline const std::vector<std::string> kHan = {"han_m1", "han_m2", "han_m3"};
+// Every CPU model (the fast ones; their _ref twins give the same bits).
+inline const std::vector<std::string> kCpuModels = {"han_m1",        "han_m2",       "han_m3",     "halen_spring",
+                                                    "halen_cascade", "halen_forest", "plante_wisp"};
 
 }  // namespace hairbench::test
