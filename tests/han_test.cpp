@@ -1,6 +1,8 @@
 // Properties Han & Harada 2012 claims for methods 1-3, checked on the built-in scenarios.
 #include "test_support.h"
 
+#include "scenarios/groom_gen.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -59,27 +61,63 @@ TEST(HanMethods, QuietStart) {
 }
 
 // §6: "Method 2 can be as smooth as method 1 if a high number of iterations is used":
-// its deviation from method 1 on `shake` shrinks as both get more local iterations.
-// Known difference: the deviation once the head has stopped (the last frame) falls at
-// every step 1 -> 2 -> 4 -> 8 -> 16, but the RMS over the whole run, dominated by the
-// 2 Hz shake itself, does not fall before 8 iterations (0.033, 0.036, 0.038, 0.033,
-// 0.022 in the paper setting): the two solvers' unconverged Gauss-Seidel and Jacobi
-// paths differ most while the motion is violent. The test asserts what holds: the
-// settled deviation at each step and the RMS from 1 to 16.
+// its deviation from method 1 on `shake` (RMS over the run) falls at every doubling of
+// the local iterations, 1 -> 2 -> 4 -> 8 -> 16, to under a fifth. Known difference: the
+// deviation once the head has stopped (the last frame) does not fall at every step
+// (5.6e-4, 9.1e-4, 6.9e-4, 3.5e-4, 1.5e-4 L-bar; the RMS 9.7e-3 to 6.5e-4): both methods rest
+// in equilibria under gravity that differ by less than 1e-3 L-bar at any count, which is
+// asserted instead.
 TEST(HanMethods, Method2ConvergesToMethod1WithIterations) {
   const Scenario sc = builtin("shake");
-  double last_final = INFINITY, first_rms = 0.0, rms = 0.0;
+  double last_rms = INFINITY, first_rms = 0.0;
   for (int it : {1, 2, 4, 8, 16}) {
     auto setting = test::paper_setting();
     setting.push_back({"*", "local_iterations", double(it)});
     const auto runs = test::run(sc, {"han_m1", "han_m2"}, setting);
     const RunRecord& m2 = test::find(runs, "han_m2");
-    EXPECT_LT(m2.deviation.back(), last_final) << "local_iterations " << it;
-    last_final = m2.deviation.back();
-    rms = test::rms_of(m2.deviation);
+    const double rms = test::rms_of(m2.deviation);
+    RecordProperty("rms_" + std::to_string(it), std::to_string(rms));
+    RecordProperty("final_" + std::to_string(it), std::to_string(m2.deviation.back()));
+    EXPECT_LT(rms, last_rms) << "local_iterations " << it;
+    EXPECT_LT(m2.deviation.back(), 1e-3) << "local_iterations " << it;
     if (it == 1) first_rms = rms;
+    last_rms = rms;
   }
-  EXPECT_LT(rms, 0.8 * first_rms);
+  EXPECT_LT(last_rms, 0.2 * first_rms);
+}
+
+// A built-in scenario with a curly groom of `strands` strands (the generator's helix, 12 mm
+// radius and 40 mm pitch: consecutive rest edges turn by about 60°). §3.4: "If the hair
+// style is very curly, then more iteration is usually needed".
+Scenario curly(const std::string& name, int strands) {
+  Scenario sc = load_scenario(find_scenario(name));
+  GroomSpec spec;
+  spec.style = "curly";
+  spec.strands = strands;
+  sc.groom = generate_groom(spec, sc.head_radius, "han_test").groom;
+  return sc;
+}
+
+// Method 2 (Algorithm 4) on a curly groom, at rest and on `shake`, with 1, 2 and 4 local
+// iterations: stable, and between methods 1 and 3 as §6 ranks them: no farther from
+// method 1 than method 3 is, and no more jagged than method 3. This rests on the
+// algorithm's line order (each frame rebuilt right after its own edge's constraint,
+// local_shape_m2): frames rebuilt only after both batches read edges the other batch has
+// bent, and on this groom the strands then never settle.
+TEST(HanMethods, Method2OnCurlyGroom) {
+  for (const char* name : {"idle", "shake"}) {
+    const Scenario sc = curly(name, 500);
+    for (int it : {1, 2, 4}) {
+      const auto runs = test::run(sc, kHan, {{"*", "local_iterations", double(it)}});
+      const RunRecord& m2 = test::find(runs, "han_m2");
+      const RunRecord& m3 = test::find(runs, "han_m3");
+      const std::string at = std::string(name) + " local_iterations " + std::to_string(it);
+      EXPECT_EQ(m2.verdict.status, verdict::Status::ok) << at << ": " << m2.verdict.reason;
+      EXPECT_EQ(m3.verdict.status, verdict::Status::ok) << at << ": " << m3.verdict.reason;
+      EXPECT_LE(test::rms_of(m2.deviation), test::rms_of(m3.deviation)) << at;
+      EXPECT_LE(test::mean_of(m2.jaggedness), test::mean_of(m3.jaggedness)) << at;
+    }
+  }
 }
 
 // §6: "method 1 shows the smoothest simulation result ... Method 3 shows some jagged
@@ -98,9 +136,9 @@ TEST(HanMethods, JaggednessOrderingOnShake) {
 TEST(HanMethods, GlobalStiffnessOneFreezesZeroFrees) {
   const Scenario sc = builtin("shake");
   const auto frozen = test::run(sc, kHan, {{"*", "global_stiffness", 1.0}, {"*", "global_range", 1.0}, {"*", "global_ramp", 0}});
-  // Method 2's local pass still reads frames one iteration old, so after the global
-  // pass has frozen the hair it nudges it by up to ~2e-4 L-bar; "frozen" is 1e-3 here.
-  for (const RunRecord& r : frozen) EXPECT_LT(test::max_of(r.rest_shape_error), 1e-3) << r.model;
+  // Frozen to rounding, method 2 included: its transforms, kept relative to the head, are
+  // exact for hair that the head carries rigidly, although they are an iteration old.
+  for (const RunRecord& r : frozen) EXPECT_LT(test::max_of(r.rest_shape_error), 1e-6) << r.model;
   const auto free = test::run(sc, kHan, {{"*", "global_stiffness", 0.0}, {"*", "local_stiffness", 0.0}});
   for (const RunRecord& r : free) EXPECT_GT(test::max_of(r.rest_shape_error), 0.1) << r.model;
 }

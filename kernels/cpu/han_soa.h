@@ -37,17 +37,17 @@ enum Field : int {
   kM3Fields,
   LX = kM3Fields, LY, LZ,  // ^{i-1}P_i^0
   kM1Fields,
-  OW = kM1Fields, OX, OY, OZ,  // method 2's frames wR_i, persistent across frames
+  OW = kM1Fields, OX, OY, OZ,  // method 2's frames wR_i relative to the head, persistent
   kM2Fields
 };
 inline constexpr int field_count(int method) {
   return method == 3 ? kM3Fields : method == 1 ? kM1Fields : kM2Fields;
 }
-// Methods 1 and 2 also keep the rest frames of vertices 0 and 1 (w, x, y, z each, one row
+// Method 1 also keeps the rest frames of vertices 0 and 1 (w, x, y, z each, one row
 // of kLanes per component) after the fields.
 inline constexpr int kRestFrameRows = 8;
 inline constexpr std::size_t block_floats(int method, int n) {
-  return static_cast<std::size_t>(field_count(method) * n + (method == 3 ? 0 : kRestFrameRows)) * kLanes;
+  return static_cast<std::size_t>(field_count(method) * n + (method == 1 ? kRestFrameRows : 0)) * kLanes;
 }
 // Floats of per-thread scratch a block of n vertices needs (method 3's head-rotated rest
 // edges or method 2's copy of the frames, the local constraint's mass weights, and the

@@ -67,17 +67,19 @@ inline void rotate(float qx, float qy, float qz, float qw, float vx, float vy, f
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 // The frame of vertex i from its parent's frame and the edge (a, b): Algorithm 3, lines
 // 10-12, as kernels::child_frame (strand_kernels.cpp) with rotation_from_x (frames.h).
-// out may be parent (each lane reads its parent before its result is stored).
-inline void child_frame(const Quat& parent, const float* ax, const float* ay, const float* az, const float* bx,
-                        const float* by, const float* bz, Quat& out) {
+// The edge is read in the parent's world frame `world`; the result is composed onto
+// `parent`, which is `world` itself (method 1) or its head-relative form (method 2).
+// out may be parent or world (each lane reads them before its result is stored).
+inline void child_frame(const Quat& parent, const Quat& world, const float* ax, const float* ay, const float* az,
+                        const float* bx, const float* by, const float* bz, Quat& out) {
   Quat r;
   alignas(64) float ok[W];
   LANES {
     const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
     const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
     ok[l] = len > 0.0f ? 1.0f : 0.0f;
-    float vx, vy, vz;  // parent^-1 · (edge / len): the conjugate's vector part is negated
-    rotate(-parent.x[l], -parent.y[l], -parent.z[l], parent.w[l], ex / len, ey / len, ez / len, vx, vy, vz);
+    float vx, vy, vz;  // world^-1 · (edge / len): the conjugate's vector part is negated
+    rotate(-world.x[l], -world.y[l], -world.z[l], world.w[l], ex / len, ey / len, ez / len, vx, vy, vz);
     // rotation_from_x(v): (1 + v_x, 0, -v_z, v_y) normalised; half a turn about z at v = -x.
     const float w = 1.0f + vx;
     const float n2 = (0.0f * 0.0f + vy * vy) + (vz * vz + w * w);
@@ -521,16 +523,18 @@ void local_m1(const M1Block* blk, int n, const Substep& s, float stiffness) {
       }
       local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, k.ka + b, k.kb + b,
                  gx[j], gy[j], gz[j], stiffness);
-      child_frame(frame[j], r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, frame[j]);
+      child_frame(frame[j], frame[j], r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, frame[j]);
     }
   }
 }
 
-// Method 2 (Algorithm 4): goals from the previous iteration's frames (copied to
-// scratch), even/odd batches, then every frame rebuilt from its parent's old frame.
-void local_m2(const Rows& r, int n, const float* lx, const float* ly, const float* lz, const float* rest_frames,
-              float* ow, float* ox, float* oy, float* oz, float* scratch, const float* ka, const float* kb,
-              const Substep& s, float stiffness) {
+// Method 2 (Algorithm 4, local_shape_m2): the frames are kept relative to the head and
+// composed with its rotation where used; goals and parents come from the previous
+// iteration's frames (copied to scratch), even/odd batches, each edge's frame rebuilt
+// right after that edge's constraint. Rows 0 and 1 of the frames hold the rest frames
+// of the pinned vertices from the start and are never written.
+void local_m2(const Rows& r, int n, const float* lx, const float* ly, const float* lz, float* ow, float* ox, float* oy,
+              float* oz, float* scratch, const float* ka, const float* kb, const Substep& s, float stiffness) {
   if (n < 3) return;
   alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[W], gy[W], gz[W];
   LANES {
@@ -538,17 +542,6 @@ void local_m2(const Rows& r, int n, const float* lx, const float* ly, const floa
     hy[l] = s.q[1];
     hz[l] = s.q[2];
     hw[l] = s.q[3];
-  }
-  for (int v = 0; v < 2; ++v) {
-    const float* rr = rest_frames + 4 * v * W;
-    Quat q;
-    quat_mul(hx, hy, hz, hw, rr + W, rr + 2 * W, rr + 3 * W, rr, q);
-    LANES {
-      ow[v * W + l] = q.w[l];
-      ox[v * W + l] = q.x[l];
-      oy[v * W + l] = q.y[l];
-      oz[v * W + l] = q.z[l];
-    }
   }
   const int nw = n * W;
   float *sw = scratch, *sx = scratch + nw, *sy = scratch + 2 * nw, *sz = scratch + 3 * nw;
@@ -560,33 +553,31 @@ void local_m2(const Rows& r, int n, const float* lx, const float* ly, const floa
   for (int first : {2, 3})
     for (int i = first; i < n; i += 2) {
       const int a = (i - 1) * W, b = i * W;
+      Quat parent, world, out;
+      LANES {
+        parent.x[l] = sx[a + l];
+        parent.y[l] = sy[a + l];
+        parent.z[l] = sz[a + l];
+        parent.w[l] = sw[a + l];
+      }
+      quat_mul(hx, hy, hz, hw, parent.x, parent.y, parent.z, parent.w, world);
       LANES {
         float tx, ty, tz;
-        rotate(sx[a + l], sy[a + l], sz[a + l], sw[a + l], lx[b + l], ly[b + l], lz[b + l], tx, ty, tz);
+        rotate(world.x[l], world.y[l], world.z[l], world.w[l], lx[b + l], ly[b + l], lz[b + l], tx, ty, tz);
         gx[l] = r.px[a + l] + tx;
         gy[l] = r.py[a + l] + ty;
         gz[l] = r.pz[a + l] + tz;
       }
       local_edge(r.px + a, r.py + a, r.pz + a, r.iw + a, r.px + b, r.py + b, r.pz + b, r.iw + b, ka + b, kb + b, gx, gy, gz,
                  stiffness);
+      child_frame(parent, world, r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, out);
+      LANES {
+        ow[b + l] = out.w[l];
+        ox[b + l] = out.x[l];
+        oy[b + l] = out.y[l];
+        oz[b + l] = out.z[l];
+      }
     }
-  Quat parent, out;
-  for (int i = 2; i < n; ++i) {
-    const int a = (i - 1) * W, b = i * W;
-    LANES {
-      parent.x[l] = sx[a + l];
-      parent.y[l] = sy[a + l];
-      parent.z[l] = sz[a + l];
-      parent.w[l] = sw[a + l];
-    }
-    child_frame(parent, r.px + a, r.py + a, r.pz + a, r.px + b, r.py + b, r.pz + b, out);
-    LANES {
-      ow[b + l] = out.w[l];
-      ox[b + l] = out.x[l];
-      oy[b + l] = out.y[l];
-      oz[b + l] = out.z[l];
-    }
-  }
 }
 
 // Edge length constraints (edge_length) in even/odd batches.
@@ -712,7 +703,7 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
                sc,
                sc + 4 * rows,
                sc + 5 * rows,
-               method == 3 ? nullptr : d + static_cast<std::size_t>(field_count(method)) * rows,
+               method == 1 ? d + static_cast<std::size_t>(field_count(method)) * rows : nullptr,
                rows};
     if (method == 1)
       m1[j] = M1Block{c[j].r, field(LX), field(LY), field(LZ), c[j].rest_frames, c[j].ka, c[j].kb};
@@ -785,8 +776,8 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
         } else {
           for (int j = 0; j < count; ++j) {
             const Ctx& b = c[j];
-            local_m2(b.r, n, b.field(LX), b.field(LY), b.field(LZ), b.rest_frames, b.field(OW), b.field(OX),
-                     b.field(OY), b.field(OZ), b.scratch, b.ka, b.kb, s, p.local_stiffness);
+            local_m2(b.r, n, b.field(LX), b.field(LY), b.field(LZ), b.field(OW), b.field(OX), b.field(OY),
+                     b.field(OZ), b.scratch, b.ka, b.kb, s, p.local_stiffness);
           }
         }
         done(kLocal);

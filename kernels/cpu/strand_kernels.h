@@ -51,8 +51,9 @@ void local_shape_m1(std::span<Vec4f> pos, std::span<const Quatf> rest_rotation,
 
 // Method 2 (Algorithm 4): Jacobi-style. Goals use the frames of the previous iteration
 // (`rotation` on entry, copied to `scratch`); constraints run in even/odd edge batches
-// (§5) and afterwards every frame is rebuilt from its parent's previous-iteration frame.
-// `rotation` persists across iterations and frames.
+// (§5), and each edge's frame is rebuilt from its parent's previous-iteration frame right
+// after that edge's constraint (lines 12-16, one thread's sequence). `rotation` persists
+// across iterations, substeps and frames: the transforms are simulation state (§5).
 void local_shape_m2(std::span<Vec4f> pos, std::span<Quatf> rotation, std::span<Quatf> scratch,
                     std::span<const Quatf> rest_rotation, std::span<const Vec3f> rest_local,
                     const Quatf& head_rotation, float stiffness);

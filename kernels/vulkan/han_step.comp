@@ -70,12 +70,14 @@ vec4 rotation_from_x(vec3 v) {
   return qnormalize(vec4(0.0, -v.z, v.y, w));
 }
 
-// Frame of vertex b from its parent's frame and the edge a -> b (Algorithm 3, 10-12).
-vec4 child_frame(vec4 parent, vec3 a, vec3 b) {
+// Frame of vertex b from its parent's frame and the edge a -> b (Algorithm 3, 10-12):
+// the edge is read in the parent's world frame `world`, the result composed onto
+// `parent` (`world` itself for method 1, its head-relative form for method 2).
+vec4 child_frame(vec4 parent, vec4 world, vec3 a, vec3 b) {
   vec3 edge = b - a;
   float len = sqrt(dot(edge, edge));
   if (!(len > 0.0)) return parent;
-  return qnormalize(qmul(parent, rotation_from_x(qrot(qconj(parent), edge / len))));
+  return qnormalize(qmul(parent, rotation_from_x(qrot(qconj(world), edge / len))));
 }
 
 // Eq. 4 with inverse-mass weights on edge (a, b) of shared memory.
@@ -202,18 +204,20 @@ void main() {
           for (uint i = 2u; i < n; ++i) {
             const vec3 goal = s_pos[base + i - 1u].xyz + qrot(f, g_rest_local[b + i].xyz);
             local_shape_edge(base + i - 1u, base + i, goal, r.local_stiffness);
-            f = child_frame(f, s_pos[base + i - 1u].xyz, s_pos[base + i].xyz);
+            f = child_frame(f, f, s_pos[base + i - 1u].xyz, s_pos[base + i].xyz);
           }
         }
         sync();
       } else if (METHOD == 2u) {
-        // Algorithm 4: goals read the previous iteration's frames (wT_temp, line 5),
-        // shared after a barrier (line 6); even then odd edges (§5); then every frame is
-        // rebuilt from its parent's previous-iteration frame.
+        // Algorithm 4: the frames are kept relative to the head and composed with its
+        // rotation where used (line 13); those of vertices 0 and 1 stay their rest
+        // frames. Goals and parents read the previous iteration's frames (wT_temp, line
+        // 5), shared after a barrier (line 6); even then odd edges (§5); each invocation
+        // rebuilds its vertex's frame right after its own constraint (lines 12-16),
+        // before the other batch moves the edge.
         for (uint k = 0u; k < VPL; ++k) {
           const uint i = lane + k * LANES;
           if (i >= n || !local) break;
-          if (i < 2u) rot[k] = qmul(head_rotation, g_rest_rot[b + i]);
           s_rot[base + i] = rot[k];
         }
         sync();
@@ -222,17 +226,14 @@ void main() {
             const uint i = lane + k * LANES;
             if (i >= n || !local) break;
             if (i < first || (i - first) % 2u != 0u) continue;
-            const vec3 goal = s_pos[base + i - 1u].xyz + qrot(s_rot[base + i - 1u], rest_local[k].xyz);
+            const vec4 parent = s_rot[base + i - 1u];
+            const vec4 world = qmul(head_rotation, parent);
+            const vec3 goal = s_pos[base + i - 1u].xyz + qrot(world, rest_local[k].xyz);
             local_shape_edge(base + i - 1u, base + i, goal, r.local_stiffness);
+            rot[k] = child_frame(parent, world, s_pos[base + i - 1u].xyz, s_pos[base + i].xyz);
           }
           sync();
         }
-        for (uint k = 0u; k < VPL; ++k) {
-          const uint i = lane + k * LANES;
-          if (i >= n || !local) break;
-          if (i >= 2u) rot[k] = child_frame(s_rot[base + i - 1u], s_pos[base + i - 1u].xyz, s_pos[base + i].xyz);
-        }
-        sync();
       } else {
         // Algorithm 5: the head-rotated rest edges, even then odd edges (§5).
         for (uint first = 2u; first <= 3u; ++first) {

@@ -139,7 +139,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
           at(soa::OZ, i, l) = q.z();
         }
       }
-      if (b.method != 3) {
+      if (b.method == 1) {
         float* frames = d + static_cast<std::size_t>(soa::field_count(b.method)) * rows;
         for (int v = 0; v < 2; ++v) {
           const Quatf& q = rest_rotation[v0 + static_cast<std::size_t>(v)];
