@@ -30,6 +30,9 @@ PlanteStyleTiming time_plante_style(const PlanteStyle& style, int frames) {
   shake.dt = kPlanteFrameDt;
   ParamSet params(plante::kParams, groom.region_names.size());
   params.set("wisps", style.wisps, {"plante2001", ""});
+  // The paper's segments per wisp (§5.3), the pinned first one included, rather than the
+  // wisp width's resolution.
+  params.set("skeleton_segments", style.vertices - 2, {"plante2001", ""});
   // The paper's wisp counts, unsplit: the width cap (settings.h) bounds the rebuilt
   // strands' edge error, which this timing does not measure.
   params.set("wisp_width_max", 1000, {"plante2001", ""});

@@ -25,6 +25,10 @@ void WispSystem::resize_state() {
   v.assign(n, Vec3f::Zero());
   acc.assign(n, Vec3f::Zero());
   rest_len.assign(n, 0.0f);
+  seg_mass.resize(n, 0.0f);
+  mass.assign(n, 0.0f);
+  inv_mass.assign(n, 0.0f);
+  bend_scale.assign(n, 0.0f);
   bend_local.assign(n, Vec3f::Zero());
   e1.assign(n, Vec3f::UnitX());
   e2.assign(n, Vec3f::UnitY());
@@ -135,15 +139,7 @@ Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& c, const N
   return point_in(section_between(s, k, j, std::abs(c.x()), sections[k], sections[j]), c);
 }
 
-Vec4f strand_coord(const WispSystem& s, std::size_t w, std::uint32_t k, const Vec3f& p,
-                   const Eigen::Matrix3f& head_rot) {
-  const float along = (p - s.x[k]).dot(s.n[k]);
-  float sfrac = 0.0f;
-  constexpr float kMaxFraction = 0.999f;
-  if (along > 0.0f && k + 1 < s.node_begin[w + 1])
-    sfrac = std::min(along / (s.x[k + 1] - s.x[k]).norm(), kMaxFraction);
-  else if (along < 0.0f && k > s.node_begin[w])
-    sfrac = std::max(along / (s.x[k] - s.x[k - 1]).norm(), -kMaxFraction);
+Vec4f strand_coord(const WispSystem& s, std::uint32_t k, float sfrac, const Vec3f& p, const Eigen::Matrix3f& head_rot) {
   const SectionFrame f = section_frame(s, k, sfrac, head_rot);
   const Vec3f d = p - f.origin;
   return Vec4f(sfrac, d.dot(f.e1), d.dot(f.e2), d.dot(f.n));
@@ -184,6 +180,22 @@ void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend) {
     s.x[k] = s.rest_x[k];
     s.v[k] = Vec3f::Zero();
     s.rest_len[k] = k == b ? 0.0f : (s.rest_x[k] - s.rest_x[k - 1]).norm();
+    // Lumped masses: each node carries half of each adjacent segment's hair, so that on
+    // any segment lengths a node's springs (each scaled by its segment's hair) accelerate
+    // it by at most twice their stiffness per metre (settings.h: the stable step).
+    s.mass[k] = 0.5f * ((k > b ? s.seg_mass[k] : 0.0f) + (k + 1 < e ? s.seg_mass[k + 1] : 0.0f));
+    s.inv_mass[k] = 1.0f / s.mass[k];
+  }
+  // The bending spring at node k-1 scales with the shorter and lighter of its two
+  // segments, so that the lateral stiffness it puts on nodes k and k-2 stays within the
+  // stable step whatever their ratio; where segment (k-2, k-1) is pinned (the head's,
+  // §3.2) only segment (k-1, k) counts: a pinned node takes any stiffness, and the root
+  // must hold the whole wisp's weight.
+  for (std::uint32_t k = b + 2; k < e; ++k) {
+    const bool head_segment = s.pinned[k - 2] && s.pinned[k - 1];
+    const float l0 = head_segment ? s.rest_len[k] : std::min(s.rest_len[k], s.rest_len[k - 1]);
+    const float m = head_segment ? s.seg_mass[k] : std::min(s.seg_mass[k], s.seg_mass[k - 1]);
+    s.bend_scale[k] = l0 * l0 * m;
   }
   const Vec3f n0 = e - b >= 2 ? unit_or(s.rest_x[b + 1] - s.rest_x[b], Vec3f::UnitY()) : Vec3f::UnitY();
   Vec3f ref = n0.cross(Vec3f::UnitZ());
@@ -233,7 +245,8 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     }
     s.acc[k] = a;
   }
-  // Linear damped axial springs (§3.2).
+  // Linear damped axial springs (§3.2): the force of segment (k-1, k) is its hair times
+  // the stiffness times the stretch, each end accelerated by that over its mass.
   // Each segment's length and direction are kept for the bending springs.
   for (std::uint32_t k = b + 1; k < e; ++k) {
     const Vec3f d = s.x[k] - s.x[k - 1];
@@ -242,23 +255,25 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     if (!(len > 0.0f)) continue;
     const Vec3f t = d / len;
     s.seg_t[k] = t;
-    const float f = p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t);
-    s.acc[k - 1] += f * t;
-    s.acc[k] -= f * t;
+    const float f =
+        s.seg_mass[k] * (p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t));
+    s.acc[k - 1] += (f * s.inv_mass[k - 1]) * t;
+    s.acc[k] -= (f * s.inv_mass[k]) * t;
   }
   // Damped bending springs whose force grows linearly with the bending angle (§3.2):
   // segment (k-1, k) is turned towards its rest direction relative to segment
   // (k-2, k-1), read in section frame k-2 (propagated without twist from the head,
   // §3.3) turned so that its normal is that segment: the rest style is the target.
-  // The spring is a torque k * angle * L0^2 at node k-1 (L0 the shorter rest length of
-  // the two segments, so that the lateral stiffness it puts on nodes k and k-2, torque /
-  // length^2, stays at most k whatever their ratio: with the longer one, TressFX's curls
-  // of 2 mm edges next to 5 mm ones flew apart) acting on segment (k-1, k) and,
-  // in reverse, on segment (k-2, k-1): forces on nodes k and k-2, their negated sum on
-  // k-1, so that it neither pushes nor spins the wisp as a whole. The target turns
+  // The spring is a torque k * angle * bend_scale at node k-1 (bend_scale = L0^2 m, L0
+  // and m the shorter rest length and lighter hair of the two segments, so that the
+  // lateral acceleration it puts on nodes k and k-2, torque / length^2 / mass, stays at
+  // most about k whatever their ratio: with the longer one, TressFX's curls of 2 mm
+  // segments next to 5 mm ones flew apart; wisp_init_rest) acting on segment (k-1, k)
+  // and, in reverse, on segment (k-2, k-1): forces on nodes k and k-2, their negated sum
+  // on k-1, so that it neither pushes nor spins the wisp as a whole. The target turns
   // with the whole of segment (k-2, k-1), which takes the reaction, and the torque does
-  // not grow with stretch, so the spring derives from the energy k L0^2 angle^2 / 2 (up
-  // to the frame's twist about the segment): read in the bisecting section frame
+  // not grow with stretch, so the spring derives from the energy k bend_scale angle^2 / 2
+  // (up to the frame's twist about the segment): read in the bisecting section frame
   // itself, the target turned with only half of that segment and half of the one
   // before, which takes no reaction - a follower load whose flutter grows from rounding
   // on a still head without gravity above k ~ 1e4 at 1000 Hz.
@@ -274,17 +289,16 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     const float sin_angle = axis.norm();
     Vec3f fk = Vec3f::Zero(), fk2 = Vec3f::Zero();
     if (sin_angle > 1e-7f) {
-      const float l0 = std::min(s.rest_len[k], s.rest_len[k - 1]);
-      const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * l0 * l0;
+      const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * s.bend_scale[k];
       const Vec3f a = axis / sin_angle;
       fk = (torque / len) * a.cross(t);
       fk2 = (torque / len_prev) * a.cross(t_prev);
     }
     const Vec3f dv = s.v[k] - s.v[k - 1];
-    const Vec3f damp = p.bending_damping * (dv - dv.dot(t) * t);
-    s.acc[k] += fk - damp;
-    s.acc[k - 2] += fk2;
-    s.acc[k - 1] -= fk + fk2 - damp;
+    const Vec3f damp = (p.bending_damping * s.seg_mass[k]) * (dv - dv.dot(t) * t);
+    s.acc[k] += (fk - damp) * s.inv_mass[k];
+    s.acc[k - 2] += fk2 * s.inv_mass[k - 2];
+    s.acc[k - 1] -= (fk + fk2 - damp) * s.inv_mass[k - 1];
   }
   // A wisp pinned at its tip as well (TressFX strands pinned at both ends) ends in a
   // single pinned node, not in a pinned segment as at the root (§3.2): nothing else holds
@@ -304,12 +318,12 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
       const float sin_angle = axis.norm();
       if (sin_angle > 1e-7f) {
         const float l0 = s.rest_len[e - 1];
-        const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * l0 * l0;
+        const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * l0 * l0 * s.seg_mass[e - 1];
         // Node k moves against the rotation of t about the pinned node.
-        s.acc[k] -= (torque / len) * (axis / sin_angle).cross(t);
+        s.acc[k] -= ((torque / len) * s.inv_mass[k]) * (axis / sin_angle).cross(t);
       }
       const Vec3f dv = s.v[k] - s.v[e - 1];
-      s.acc[k] -= p.bending_damping * (dv - dv.dot(t) * t);
+      s.acc[k] -= ((p.bending_damping * s.seg_mass[e - 1]) * s.inv_mass[k]) * (dv - dv.dot(t) * t);
     }
   }
   // Envelope (§3.3): non-linear damped radial springs to the skeleton mass, soft damped
@@ -652,8 +666,9 @@ ContactImpulse contact_impulse(const WispSystem& s, const WispContact& c, const 
     }
   }
 
-  // Momentum-conserving split between the point (mass mp) and the segment's skeleton
-  // (unit masses): equal masses give the paper's Delta v_p = -(...)/2.
+  // Split between the point (mass mp relative to a skeleton mass) and the segment's
+  // skeleton, both wisps' skeleton masses taken as equal: the paper's Delta v_p =
+  // -(...)/2 (§4.1), whatever hair each wisp carries.
   const Vec3f dvp = dv * (1.0f / (1.0f + mp));
   // The segment's nodes take the opposite impulse, shared linearly. In the average over a
   // node's contacts, a contact counts by the share of the relative velocity it asks the

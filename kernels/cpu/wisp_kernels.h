@@ -3,8 +3,13 @@
 // cross-sections (§3.3), and the velocity/position modifications of the interactions
 // (§4). The model adapter (models/plante_wisp) owns the loop of §5.1 and the rates.
 //
-// Units: every force is an acceleration of the mass it acts on (skeleton masses are 1,
-// envelope masses `envelope_mass`), stiffnesses are in 1/s^2, dampings in 1/s.
+// Units: a skeleton mass is the hair its node carries, in strand-metres (the length of
+// the wisp's strands that the node stands for: half of each adjacent segment's hair), an
+// envelope mass `envelope_mass` times its node's. Stiffnesses are in 1/s^2 and dampings
+// in 1/s per unit of the hair a spring holds (WispSystem::seg_mass): a segment's axial
+// spring pulls with (stiffness x stretch x its hair), so that on skeletons of equal
+// segments a node accelerates by stiffness x stretch, as the explicit integration's
+// stable step (§5.3, settings.h) asks, whatever the wisp's strand count.
 #pragma once
 
 #include "core/types.h"
@@ -18,10 +23,10 @@ namespace hairbench::kernels {
 // Physical parameters of one wisp (one per groom region).
 struct WispParams {
   float air_drag = 5.0f;            // 1/s, on every mass's absolute velocity (§5.1 "air resistance")
-  float axial_stiffness = 4e5f;     // 1/s^2 per metre of stretch (§3.2 linear axial springs)
-  float axial_damping = 40.0f;      // 1/s on the relative axial velocity
-  float bending_stiffness = 1e5f;   // 1/s^2: lateral acceleration = k * angle * rest length (§3.2)
-  float bending_damping = 60.0f;    // 1/s on the relative lateral velocity
+  float axial_stiffness = 4e5f;     // 1/s^2 per metre of stretch, times the segment's hair (§3.2)
+  float axial_damping = 40.0f;      // 1/s on the relative axial velocity, times the segment's hair
+  float bending_stiffness = 1e5f;   // 1/s^2: torque = k * angle * bend_scale (§3.2)
+  float bending_damping = 60.0f;    // 1/s on the relative lateral velocity, times the segment's hair
   float envelope_mass = 0.1f;       // envelope mass / skeleton mass (§3.3 "much lighter")
   float radial_stiffness = 5e4f;    // 1/s^2, compression branch at small strain (§3.3)
   float radial_stretch = 0.3f;      // stretch stiffness as a fraction of the compression one
@@ -67,6 +72,17 @@ struct WispSystem {
   std::vector<Vec3f> x, v, acc;   // acc: scratch of wisp_forces_and_velocities (the block kernel keeps its own)
   std::vector<Vec3f> rest_x;      // head rest frame
   std::vector<std::uint8_t> pinned;
+  // The hair of segment (k-1, k), strand-metres, stored at k (0 at a wisp's first node):
+  // the length of the wisp's strands whose sections lie along that segment.
+  std::vector<float> seg_mass;
+  // Per node: its mass, half the hair of each adjacent segment (so a wisp's masses sum to
+  // the length of its strands), and 1 / mass.
+  std::vector<float> mass, inv_mass;
+  // The bending spring at node k-1 (segments (k-2, k-1) and (k-1, k)), stored at k: its
+  // torque is bending_stiffness x angle x bend_scale[k], bend_scale = L0^2 x m with L0
+  // the shorter rest length and m the lighter hair of the two segments, of (k-1, k) alone
+  // where (k-2, k-1) is the head's (wisp_init_rest).
+  std::vector<float> bend_scale;
   std::vector<float> rest_len;    // segment (k-1, k), stored at k (0 at a wisp's first node)
   std::vector<Vec3f> bend_local;  // rest direction of segment (k-1, k) in frame k-2 turned onto segment (k-2, k-1)
   // Section frames (§3.3): e1, e2 span the plane bisecting the adjacent segments, n its
@@ -102,8 +118,9 @@ struct WispSystem {
 
   std::size_t wisp_count() const { return node_begin.size() - 1; }
   std::size_t node_count() const { return x.size(); }
-  // Sizes every state array after node_begin, wisp_params, rest_x and pinned are filled;
-  // the state is the rest state (x = rest_x, still, envelope at rest radius r_rest).
+  // Sizes every state array after node_begin, wisp_params, rest_x, pinned and seg_mass
+  // are filled; the state is the rest state (x = rest_x, still, envelope at rest radius
+  // r_rest).
   void resize_state();
 };
 
@@ -124,9 +141,10 @@ inline Vec3f envelope_point(const WispSystem& s, std::size_t k, int q) {
 // node k: the section it lies in is interpolated a fraction |s| of the way to node
 // k + sign(s) (origin, axes and envelope scale), (a, b) are its coordinates in that
 // section's plane, scaled on each half-axis by its envelope mass's radius over the rest
-// radius, and c a small offset along the section normal. Following the skeleton this
-// way, a strand whose vertices sit a little ahead of or behind the wisp's nodes still
-// bends with the wisp instead of swinging about the nodes' normals.
+// radius, and c an offset along the section normal. The skeleton has its own resolution
+// (a few segments about as long as the wisp is wide, §4.1 footnote 1, §5.3), so a
+// strand's vertices lie in sections interpolated between the nodes and bend with the
+// wisp along each segment.
 //
 // Near the root the section axes (and the envelope's scale, towards 1) are blended
 // towards the head-carried rest axes (frame_weight): every strand is rooted at its own point of the scalp and bends there,
@@ -149,10 +167,10 @@ NodeSection node_section(const WispSystem& s, std::uint32_t k, const Eigen::Matr
 Vec3f strand_point(const WispSystem& s, std::uint32_t k, const Vec4f& coord, const NodeSection* sections);
 // frame_weight interpolated like the section of strand_point at coordinate sfrac.
 float section_weight(const WispSystem& s, std::uint32_t k, float sfrac);
-// The coordinates of p relative to node k of wisp w in the current state, exact for
-// strand_point when the envelope is at its rest radii.
-Vec4f strand_coord(const WispSystem& s, std::size_t w, std::uint32_t k, const Vec3f& p,
-                   const Eigen::Matrix3f& head_rot);
+// The coordinates of p in the section a fraction sfrac of the way from node k towards
+// k + sign(sfrac), in the current state: exact for strand_point when the envelope is at
+// its rest radii.
+Vec4f strand_coord(const WispSystem& s, std::uint32_t k, float sfrac, const Vec3f& p, const Eigen::Matrix3f& head_rot);
 // Scale factors (current / rest radius) of the section interpolated like strand_point,
 // for the half-axes on the sides of a and b: the envelope's extent there is
 // r_rest-interpolated times this scale.
@@ -171,9 +189,9 @@ Vec3f minimal_rotate(const Vec3f& a, const Vec3f& b, const Vec3f& v);
 // minimally rotated from n_{k-1} to n_k (§3.3).
 void wisp_frames(WispSystem& s, std::size_t w, const Vec3f& root_e1);
 
-// Rest data of wisp w from its rest skeleton (rest_x): rest lengths, frames, the rest
-// bending directions, and frame weights ramping from 0 to 1 over the `root_blend` free
-// nodes after the pinned ones.
+// Rest data of wisp w from its rest skeleton (rest_x) and its segments' hair (seg_mass):
+// rest lengths, masses, bending scales, frames, the rest bending directions, and frame
+// weights ramping from 0 to 1 over the `root_blend` free nodes after the pinned ones.
 void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend);
 
 // Pinned nodes follow the head transform `head`; their velocities are the displacement
@@ -285,8 +303,10 @@ struct alignas(64) SegmentVolume {
 // relative velocity within asin(in_plane_sin) of their common plane) lose the relative
 // velocity normal to that plane and get a viscous in-plane drag min(1, hair_friction *
 // density * h), h the period the response stands for; other contacts are inelastic
-// collisions (relative velocity removed). Splits are momentum-conserving: equal masses
-// give the paper's halves.
+// collisions (relative velocity removed). The split takes the two wisps' skeleton
+// masses as equal, whatever hair they carry: the paper sets both wisps' velocities to
+// "the average of their initial values" (§4.1); an envelope point weighs envelope_mass
+// of that.
 void wisp_contacts_respond(WispSystem& s, std::span<const WispContact> contacts, const InteractionParams& ip,
                            std::span<const WispParams> params, float h);
 

@@ -65,10 +65,10 @@ using ImpulsesFn = void (*)(const WispSystem& s, const ContactNode* nodes, std::
                             std::span<const WispParams> params, float h, ContactImpulse* out);
 
 // The rebuild's strand points (§5.2) of one strand of n vertices, vertex i at
-// coordinates coord[i] relative to node first_node + i: strand_point (from every node's
+// coordinates coord[i] relative to node node[i]: strand_point (from every node's
 // NodeSection, `sections`) into point[i] and section_weight into weight[i], 16 vertices
 // at a time, with the per-vertex kernel's bits.
-using StrandPointsFn = void (*)(const WispSystem& s, const NodeSection* sections, std::uint32_t first_node,
+using StrandPointsFn = void (*)(const WispSystem& s, const NodeSection* sections, const std::uint32_t* node,
                                 const Vec4f* coord, std::uint32_t n, Vec3f* point, float* weight);
 
 // A BodyStep as the lane kernels read it, in plain floats: Eigen's fixed-size types may

@@ -167,6 +167,7 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   const int n = blk.n;
   V3 x[N], v[N], e1[N], e2[N], nn[N], bl[N], acc[N], seg_t[N];
   float rest_len[N * W], free[N * W], r_rest[N * W], seg_len[N * W];
+  float seg_mass[N * W], inv_mass[N * W], bend_scale[N * W];
   float r[N * Q * W], rdot[N * Q * W], racc[N * Q * W];
   blk.load(x, s.x);
   blk.load(v, s.v);
@@ -175,6 +176,9 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   blk.load(nn, s.n);
   blk.load(bl, s.bend_local);
   blk.load(rest_len, s.rest_len, 1);
+  blk.load(seg_mass, s.seg_mass, 1);
+  blk.load(inv_mass, s.inv_mass, 1);
+  blk.load(bend_scale, s.bend_scale, 1);
   blk.load_free(free, s.pinned);
   blk.load(r_rest, s.r_rest, 1);
   blk.load(r, s.r, Q);
@@ -206,10 +210,10 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       bad[l] |= !(len > 0.0f);
       const F3 t = quot(d, len);
       seg_t[i].set(l, t);
-      const float f =
-          p.axial_stiffness * (len - rest_len[i * W + l]) + p.axial_damping * dot(sub(v[i].get(l), v[i - 1].get(l)), t);
-      acc[i - 1].set(l, add(acc[i - 1].get(l), mul(f, t)));
-      acc[i].set(l, sub(acc[i].get(l), mul(f, t)));
+      const float f = seg_mass[i * W + l] * (p.axial_stiffness * (len - rest_len[i * W + l]) +
+                                             p.axial_damping * dot(sub(v[i].get(l), v[i - 1].get(l)), t));
+      acc[i - 1].set(l, add(acc[i - 1].get(l), mul(f * inv_mass[(i - 1) * W + l], t)));
+      acc[i].set(l, sub(acc[i].get(l), mul(f * inv_mass[i * W + l], t)));
     }
   }
   // Bending springs.
@@ -229,18 +233,16 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       const float len = seg_len[i * W + l], len_prev = seg_len[(i - 1) * W + l];
       const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
       const bool bends = sin_angle[l] > 1e-7f;
-      const float ra = rest_len[i * W + l], rb = rest_len[(i - 1) * W + l];
-      const float l0 = rb < ra ? rb : ra;
-      const float torque = p.bending_stiffness * angle[l] * l0 * l0;
+      const float torque = p.bending_stiffness * angle[l] * bend_scale[i * W + l];
       const F3 a = quot(axis[l], sin_angle[l]);
       const F3 zero{0.0f, 0.0f, 0.0f};
       const F3 fk = pick(bends, mul(torque / len, cross(a, t)), zero);
       const F3 fk2 = pick(bends, mul(torque / len_prev, cross(a, t_prev)), zero);
       const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
-      const F3 damp = mul(p.bending_damping, sub(dv, mul(dot(dv, t), t)));
-      acc[i].set(l, add(acc[i].get(l), sub(fk, damp)));
-      acc[i - 2].set(l, add(acc[i - 2].get(l), fk2));
-      acc[i - 1].set(l, sub(acc[i - 1].get(l), sub(add(fk, fk2), damp)));
+      const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
+      acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
+      acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
+      acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
     }
   }
   // A wisp pinned at its tip as well: its last free segment's bending spring towards the
@@ -266,14 +268,15 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       angle[l] = tip[l] && sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(tip_target[l], t)) : 0.0f;
     }
     LANES {
-      const float len = seg_len[i * W + l], l0 = rest_len[i * W + l];
+      const float len = seg_len[i * W + l], l0 = rest_len[i * W + l], m = seg_mass[i * W + l];
+      const float im = inv_mass[(i - 1) * W + l];
       const F3 t = seg_t[i].get(l);
-      const float torque = p.bending_stiffness * angle[l] * l0 * l0;
-      const F3 spring = mul(torque / len, cross(quot(axis[l], sin_angle[l]), t));
+      const float torque = p.bending_stiffness * angle[l] * l0 * l0 * m;
+      const F3 spring = mul((torque / len) * im, cross(quot(axis[l], sin_angle[l]), t));
       const F3 before = acc[i - 1].get(l);
       const F3 turned = sin_angle[l] > 1e-7f ? sub(before, spring) : before;
       const F3 dv = sub(v[i - 1].get(l), v[i].get(l));
-      const F3 damped = sub(turned, mul(p.bending_damping, sub(dv, mul(dot(dv, t), t))));
+      const F3 damped = sub(turned, mul((p.bending_damping * m) * im, sub(dv, mul(dot(dv, t), t))));
       acc[i - 1].set(l, pick(tip[l] != 0, damped, before));
     }
   }
@@ -521,7 +524,7 @@ void impulses(const WispSystem& s, const ContactNode* nodes, std::span<const Wis
               ContactImpulse* out);
 
 // wisp_strand_kernel.cpp
-void strand_points(const WispSystem& s, const NodeSection* sections, std::uint32_t first_node, const Vec4f* coord,
+void strand_points(const WispSystem& s, const NodeSection* sections, const std::uint32_t* node, const Vec4f* coord,
                    std::uint32_t n, Vec3f* point, float* weight);
 
 // wisp_body_kernel.cpp

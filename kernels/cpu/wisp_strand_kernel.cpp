@@ -26,7 +26,7 @@ F3 section3(const float* p, int i, int at) {
 
 }  // namespace
 
-void strand_points(const WispSystem& s, const NodeSection* sections, std::uint32_t first_node, const Vec4f* coord,
+void strand_points(const WispSystem& s, const NodeSection* sections, const std::uint32_t* node, const Vec4f* coord,
                    std::uint32_t n, Vec3f* point, float* weight) {
   const float* x = s.x.data()->data();
   const float* sec = reinterpret_cast<const float*>(sections);
@@ -38,7 +38,7 @@ void strand_points(const WispSystem& s, const NodeSection* sections, std::uint32
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
       const int i = static_cast<int>(i0 + l < n ? i0 + l : n - 1);
-      const int k = static_cast<int>(first_node) + i;
+      const int k = static_cast<int>(node[i]);
       const float sfrac = cf[4 * i], ca = cf[4 * i + 1], cb = cf[4 * i + 2], cn = cf[4 * i + 3];
       const int j = sfrac > 0.0f ? k + 1 : sfrac < 0.0f ? k - 1 : k;
       const float u = std::abs(sfrac);
@@ -69,7 +69,7 @@ void strand_points(const WispSystem& s, const NodeSection* sections, std::uint32
     const std::uint32_t m = n - i0 < W ? n - i0 : W;
     for (std::uint32_t l = 0; l < m; ++l) {
       // A unit_or fallback axis: the per-vertex kernel takes it.
-      point[i0 + l] = bad[l] ? strand_point(s, first_node + i0 + l, coord[i0 + l], sections)
+      point[i0 + l] = bad[l] ? strand_point(s, node[i0 + l], coord[i0 + l], sections)
                              : Vec3f(px[l], py[l], pz[l]);
       weight[i0 + l] = wt[l];
     }

@@ -117,106 +117,325 @@ std::vector<std::vector<std::uint32_t>> kmeans_strands(const Groom& g, const std
   return out;
 }
 
-// Widest distance of a cluster's strands from their mean curve, over all vertices.
-float cluster_width(const Groom& g, const std::vector<std::uint32_t>& c) {
-  const std::size_t n = g.strand_size(c[0]);
-  float widest = 0.0f;
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3f mean = Vec3f::Zero();
-    for (std::uint32_t s : c) mean += xyz(g.positions[g.strand_begin(s) + i]);
-    mean /= static_cast<float>(c.size());
-    for (std::uint32_t s : c) widest = std::max(widest, (xyz(g.positions[g.strand_begin(s) + i]) - mean).norm());
+// The widest rest bends a skeleton keeps (skeleton_of), radians: at its free nodes,
+// and at a pinned node next to a free segment.
+constexpr float kMaxRestBend = 0.7854f;    // 45 degrees
+constexpr float kMaxAnchorBend = 2.3562f;  // 135 degrees
+
+// The average of the polyline p (vertex i at parameter at[i]) over the parameters [a, b]
+// within vertices [first, last]; the point at a where the interval is empty.
+Vec3f average(const std::vector<Vec3f>& p, const std::vector<double>& at, std::uint32_t first, std::uint32_t last,
+              double a, double b) {
+  auto point = [&](std::uint32_t v, double t) {
+    const double len = at[v + 1] - at[v];
+    const double u = len > 0.0 ? (t - at[v]) / len : 0.0;
+    return Eigen::Vector3d(p[v].cast<double>() + u * (p[v + 1] - p[v]).cast<double>());
+  };
+  if (!(b > a)) {
+    std::uint32_t v = first;
+    while (v + 1 < last && at[v + 1] < a) ++v;
+    return point(v, a).cast<float>();
   }
-  return widest;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::uint32_t v = first; v < last; ++v) {
+    const double x0 = std::max(a, at[v]), x1 = std::min(b, at[v + 1]);
+    if (x1 > x0) sum += (x1 - x0) * point(v, 0.5 * (x0 + x1));
+  }
+  return (sum / (b - a)).cast<float>();
 }
 
-// Mean rest edge length of a cluster's strands.
-float cluster_edge(const Groom& g, const std::vector<std::uint32_t>& c) {
-  double sum = 0.0;
-  std::size_t edges = 0;
-  for (std::uint32_t s : c)
-    for (std::uint32_t i = g.strand_begin(s) + 1; i < g.strand_begin(s) + g.strand_size(s); ++i, ++edges)
-      sum += (xyz(g.positions[i]) - xyz(g.positions[i - 1])).norm();
-  return edges ? static_cast<float>(sum / static_cast<double>(edges)) : 0.0f;
+// A wisp's skeleton at rest (§3.2): point masses along the axis of its strands, with a
+// resolution of its own. Every parameter below is an arc length along that axis, a curve
+// with a point per strand vertex index (the wisp's strands share it by index).
+struct Skeleton {
+  std::vector<Vec3f> x;              // node rest positions
+  std::vector<std::uint8_t> pinned;  // per node
+  std::vector<double> at;            // per node, its parameter
+  std::vector<double> vertex_at;     // per strand vertex index, its parameter
+  // Per strand vertex index: the node whose section it lies in, and the fraction of the
+  // way to the next node (kernels::strand_coord's sfrac, >= 0).
+  std::vector<std::uint32_t> vertex_node;
+  std::vector<float> vertex_u;
+  // Per segment (node j, j + 1): its hair, the length of the wisp's strands whose
+  // parameters fall in it, strand-metres.
+  std::vector<double> hair;
+  float widest = 0.0f;      // the strands' widest distance from the axis, metres
+  double free_length = 0.0;  // length of the axis the free nodes span, metres
+  int segments = 0;          // free segments
+  // The widest rest bend at a free node, and at a pinned node next to a free segment,
+  // radians.
+  float bend = 0.0f, anchor_bend = 0.0f;
+  // How far past its bounds the skeleton bends (<= 1: within them).
+  float excess() const { return std::max(bend / kMaxRestBend, anchor_bend / kMaxAnchorBend); }
+};
+
+// The skeleton of cluster c (strands of one vertex count). Pinned vertices of the mean
+// curve (all the strands pinned there) that start or end a pinned run become pinned
+// nodes: the first segment lies inside the head (§3.2), and a run pinned whole moves
+// with it. Each stretch of free vertices, from the pinned node before it to the pinned
+// node after it or to the tip, is cut into segments of equal length along the wisp's
+// axis: `segments` in all (0: the axis's free length over the wisp's width,
+// 2 max(widest, r_min), rounded and clamped to 4-10, the paper's wisps having segments
+// "mostly as wide as they are long" (§4.1, footnote 1) and 4.0-9.9 segments each
+// (§5.3), finer where the style folds, below), never more than the strands' own free
+// edges, shared between stretches by length.
+//
+// The skeleton keeps its rest bends within kMaxRestBend at its free nodes and
+// kMaxAnchorBend at a pinned node next to a free segment: the bending springs' targets
+// turn with the section frames, which is not conservative (wisp_forces_and_velocities),
+// and a skeleton bent much more than that at a node flutters by itself at the default
+// stiffness (a curly groom's skeleton laid along its curls, or a strand folded over
+// within a segment on tressfx_ponytail_spin, kept moving at 0.5 m/s with the head
+// still); next to a pinned node the section frame bisects the head's segment and the
+// first free one, and turns over as they fold back onto each other. Where the mean curve
+// bends more at the nodes of the width's resolution, the skeleton is first made finer,
+// up to the strands' own edges (a fold of the style); where that is not enough, its
+// axis is the mean curve averaged over the shortest window, in whole mean edges, that
+// is (curls and waves: the paper's skeleton carries a wisp's large-scale shape and its
+// strands the waves, §5.2, which become their offsets in the sections). Failing both,
+// the candidate that bends least past the bounds. Lengths along the axis, not along the
+// mean curve, keep the segments equal where curls are averaged away; a segment's hair
+// is then the more, the more the strands curl along it.
+Skeleton skeleton_of(const Groom& g, const std::vector<std::uint32_t>& c, int segments, float r_min) {
+  const std::uint32_t n = g.strand_size(c[0]);
+  std::vector<Vec3f> mean(n, Vec3f::Zero());
+  std::vector<std::uint8_t> pinned(n, 1);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    for (std::uint32_t s : c) {
+      const Vec4f& p = g.positions[g.strand_begin(s) + i];
+      mean[i] += xyz(p);
+      pinned[i] = pinned[i] && p.w() == 0.0f;
+    }
+    mean[i] /= static_cast<float>(c.size());
+  }
+  std::vector<double> at(n, 0.0);
+  for (std::uint32_t i = 1; i < n; ++i) at[i] = at[i - 1] + static_cast<double>((mean[i] - mean[i - 1]).norm());
+  // The free stretches [first, last] of vertex indices, their ends the pinned neighbours.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stretches;
+  std::uint32_t free_edges = 0;
+  double mean_length = 0.0, longest = 0.0;
+  for (std::uint32_t i = 0; i < n;) {
+    if (pinned[i]) {
+      ++i;
+      continue;
+    }
+    std::uint32_t j = i;
+    while (j + 1 < n && !pinned[j + 1]) ++j;
+    const std::uint32_t first = i > 0 ? i - 1 : i, last = j + 1 < n ? j + 1 : j;
+    stretches.emplace_back(first, last);
+    mean_length += at[last] - at[first];
+    longest = std::max(longest, at[last] - at[first]);
+    free_edges += last - first;
+    i = j + 1;
+  }
+  // The mean curve averaged over `window` (twice, a triangle filter: a wave whose period
+  // is about the window is gone), free vertices only, each stretch on its own, the
+  // window cut off at the stretch's ends (narrowed to stay centred there, it would leave
+  // the axis on the curls next to the root and the tip).
+  auto smooth = [&](double window) {
+    std::vector<Vec3f> axis = mean;
+    for (int pass = 0; pass < 2; ++pass) {
+      const std::vector<Vec3f> from = axis;
+      for (const auto& [first, last] : stretches)
+        for (std::uint32_t i = first; i <= last; ++i) {
+          if (pinned[i]) continue;
+          axis[i] = average(from, at, first, last, std::max(at[first], at[i] - 0.5 * window),
+                            std::min(at[last], at[i] + 0.5 * window));
+        }
+    }
+    return axis;
+  };
+  auto build = [&](const std::vector<Vec3f>& axis, int finer) {
+    Skeleton sk;
+    for (std::uint32_t i = 0; i < n; ++i)
+      for (std::uint32_t s : c)
+        sk.widest = std::max(sk.widest, (xyz(g.positions[g.strand_begin(s) + i]) - axis[i]).norm());
+    std::vector<double>& along = sk.vertex_at;
+    along.assign(n, 0.0);
+    for (std::uint32_t i = 1; i < n; ++i) along[i] = along[i - 1] + static_cast<double>((axis[i] - axis[i - 1]).norm());
+    for (const auto& [first, last] : stretches) sk.free_length += along[last] - along[first];
+    if (free_edges > 0) {
+      const double width = 2.0 * std::max(sk.widest, r_min);
+      sk.segments = segments > 0 ? segments
+                                 : std::clamp(static_cast<int>(std::lround(sk.free_length / width)), kMinSegments,
+                                              kMaxSegments);
+      sk.segments = std::min(sk.segments + finer, static_cast<int>(free_edges));
+    }
+    auto add = [&](double t, const Vec3f& p, bool pin) {
+      sk.x.push_back(p);
+      sk.pinned.push_back(pin ? 1 : 0);
+      sk.at.push_back(t);
+    };
+    std::size_t next = 0;  // stretches, in order
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (pinned[i]) {
+        if (i == 0 || !pinned[i - 1] || i + 1 == n || !pinned[i + 1]) add(along[i], axis[i], true);
+        continue;
+      }
+      const auto [first, last] = stretches[next++];
+      if (first == i) add(along[i], axis[i], false);  // no pinned node before it
+      const double length = along[last] - along[first];
+      const int parts = std::clamp(static_cast<int>(std::lround(sk.segments * length / sk.free_length)), 1,
+                                   static_cast<int>(last - first));
+      for (int j = 1; j < parts; ++j) {
+        const double t = along[first] + length * j / parts;
+        add(t, average(axis, along, first, last, t, t), false);
+      }
+      if (!pinned[last]) add(along[last], axis[last], false);  // the free tip
+      i = pinned[last] ? last - 1 : last;
+    }
+    for (std::size_t j = 1; j + 1 < sk.x.size(); ++j) {
+      if (sk.pinned[j - 1] && sk.pinned[j] && sk.pinned[j + 1]) continue;  // the head's own
+      const Vec3f a = sk.x[j] - sk.x[j - 1], b = sk.x[j + 1] - sk.x[j];
+      float& widest = sk.pinned[j] ? sk.anchor_bend : sk.bend;
+      widest = std::max(widest, std::atan2(a.cross(b).norm(), a.dot(b)));
+    }
+    return sk;
+  };
+  const double edge = free_edges > 0 ? mean_length / free_edges : 0.0;
+  Skeleton sk = build(mean, 0);
+  auto consider = [&](Skeleton other) {
+    if (other.excess() < sk.excess()) sk = std::move(other);
+  };
+  for (int finer = 1; sk.excess() > 1.0f && segments == 0 && finer < static_cast<int>(free_edges); ++finer)
+    consider(build(mean, finer));
+  for (std::uint32_t m = 1; sk.excess() > 1.0f && m * edge < longest; ++m) consider(build(smooth(m * edge), 0));
+
+  // Each strand vertex in the section through the point of the skeleton nearest its
+  // mean vertex, of the segments next to the one at its parameter along the axis: its
+  // offset then lies about in that section's plane. (At its axis parameter itself, a
+  // vertex near the root of a wisp whose axis was averaged lay up to half a window
+  // behind its section, along the section's normal, an offset that the section's turns
+  // swung into the strand's first edges.)
+  const std::size_t nodes = sk.x.size();
+  std::vector<double> param(n, 0.0);
+  sk.vertex_node.assign(n, 0);
+  sk.vertex_u.assign(n, 0.0f);
+  for (std::uint32_t i = 0; i < n && nodes > 1; ++i) {
+    const auto above = std::upper_bound(sk.at.begin(), sk.at.end(), sk.vertex_at[i]) - sk.at.begin();
+    const std::size_t guess = std::min<std::size_t>(above > 0 ? static_cast<std::size_t>(above - 1) : 0, nodes - 2);
+    const Eigen::Vector3d p = mean[i].cast<double>();
+    std::size_t best_j = guess;
+    double best_u = 0.0, best = std::numeric_limits<double>::infinity();
+    for (std::size_t j = guess > 0 ? guess - 1 : 0; j <= guess + 1 && j + 1 < nodes; ++j) {
+      const Eigen::Vector3d x0 = sk.x[j].cast<double>(), d = (sk.x[j + 1] - sk.x[j]).cast<double>();
+      const double len2 = d.squaredNorm();
+      const double u = len2 > 0.0 ? std::clamp((p - x0).dot(d) / len2, 0.0, 1.0) : 0.0;
+      const double dist = (p - (x0 + u * d)).squaredNorm();
+      if (dist < best) {
+        best = dist;
+        best_j = j;
+        best_u = u;
+      }
+    }
+    if (best_u >= 1.0) {  // node j + 1 itself
+      ++best_j;
+      best_u = 0.0;
+    }
+    param[i] = sk.at[best_j] + (best_j + 1 < nodes ? best_u * (sk.at[best_j + 1] - sk.at[best_j]) : 0.0);
+    sk.vertex_node[i] = static_cast<std::uint32_t>(best_j);
+    sk.vertex_u[i] = static_cast<float>(best_u);
+  }
+  // The strands' hair, edge by edge, shared between the segments by parameter.
+  sk.hair.assign(nodes > 0 ? nodes - 1 : 0, 0.0);
+  for (std::uint32_t i = 1; i < n && nodes > 1; ++i) {
+    double hair = 0.0;
+    for (std::uint32_t s : c) {
+      const std::uint32_t b = g.strand_begin(s);
+      hair += static_cast<double>((xyz(g.positions[b + i]) - xyz(g.positions[b + i - 1])).norm());
+    }
+    const double t0 = std::min(param[i - 1], param[i]), t1 = std::max(param[i - 1], param[i]);
+    if (!(t1 > t0)) {
+      sk.hair[std::min<std::size_t>(sk.vertex_node[i], sk.hair.size() - 1)] += hair;
+      continue;
+    }
+    for (std::size_t j = 0; j < sk.hair.size(); ++j) {
+      const double overlap = std::min(t1, sk.at[j + 1]) - std::max(t0, sk.at[j]);
+      if (overlap > 0.0) sk.hair[j] += hair * overlap / (t1 - t0);
+    }
+  }
+  return sk;
 }
 
 }  // namespace
 
-void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max) {
+void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int segments, int root_blend,
+                              float width_max, float r_min) {
   // Wisps only gather strands of one region (they share its parameters) and of one
-  // vertex count (a wisp's nodes are its strands' vertices).
+  // vertex count (their vertices share the mean curve the skeleton is laid along).
   std::map<std::pair<std::uint16_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
   for (std::size_t s = 0; s < rest.strand_count(); ++s)
     groups[{rest.strand_region[s], rest.strand_size(s)}].push_back(static_cast<std::uint32_t>(s));
   const double total = static_cast<double>(rest.strand_count());
   sys_ = {};
   strand_wisp_.assign(rest.strand_count(), 0);
-  std::vector<Vec3f> rest_x;
-  std::vector<std::vector<std::uint32_t>> members;
+  std::vector<Skeleton> skeletons;
   for (const auto& [key, strands] : groups) {
     const double share = static_cast<double>(strands.size());
     const double want = wisps > 0 ? wisps * share / total : share / strands_per_wisp;
-    // A wisp's strands keep fixed offsets in its sections (§5.2), so a section turning
-    // by an angle moves them axially by up to the wisp's radius times that angle: an edge
-    // of a strand at radius r across a node whose bend changes by phi changes by about
-    // 2 r tan(phi/2). Wisps wider than `width_max` rest edges (from their strands' mean
-    // curve) are split in two until none is; the paper's wisps are "mostly as wide as
-    // they are long" (§4.1, footnote 1), i.e. r up to half a segment.
+    // A wisp's strands keep fixed offsets in its sections (§5.2), interpolated along each
+    // segment, so a change of bend phi at a node turns the sections of the segments
+    // beside it by up to phi/2 over a segment's length: a strand at radius r from the
+    // skeleton stretches by about r phi / (2 segment length). Wisps wider than
+    // `width_max` segments (the strands' widest distance from their axis) are split in
+    // two until none is; the paper's wisps are "mostly as wide as they are
+    // long" (§4.1, footnote 1), i.e. r up to half a segment.
     std::vector<std::vector<std::uint32_t>> todo =
         kmeans_strands(rest, strands, static_cast<std::size_t>(std::max(1.0, std::round(want))), ctx_.pool);
-    std::vector<std::vector<std::uint32_t>> clusters;
+    std::vector<std::pair<std::vector<std::uint32_t>, Skeleton>> clusters;
     while (!todo.empty()) {
       std::vector<std::uint32_t> c = std::move(todo.back());
       todo.pop_back();
-      auto halves = c.size() > 1 && cluster_width(rest, c) > width_max * cluster_edge(rest, c)
+      Skeleton sk = skeleton_of(rest, c, segments, r_min);
+      auto halves = c.size() > 1 && sk.segments > 0 && sk.widest > width_max * sk.free_length / sk.segments
                         ? kmeans_strands(rest, c, 2, ctx_.pool)
                         : std::vector<std::vector<std::uint32_t>>{};
       if (halves.size() == 2) {
         for (auto& half : halves) todo.push_back(std::move(half));
       } else {
-        clusters.push_back(std::move(c));  // narrow enough, or strands k-means cannot part
+        clusters.emplace_back(std::move(c), std::move(sk));  // narrow enough, or strands k-means cannot part
       }
     }
-    std::sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) { return a.front() < b.front(); });
-    for (auto& c : clusters) {
-      const std::uint32_t n = key.second;
-      for (std::uint32_t i = 0; i < n; ++i) {
-        Vec3f mean = Vec3f::Zero();
-        bool pinned = true;
-        for (std::uint32_t s : c) {
-          const Vec4f& p = rest.positions[rest.strand_begin(s) + i];
-          mean += xyz(p);
-          pinned = pinned && p.w() == 0.0f;
-        }
-        sys_.rest_x.push_back(mean / static_cast<float>(c.size()));
-        sys_.pinned.push_back(pinned ? 1 : 0);
+    // Wisps of one node count next to each other, so that the fused schedule's blocks
+    // (one node count each) take as many of them as it can.
+    std::sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) {
+      return std::pair{a.second.x.size(), a.first.front()} < std::pair{b.second.x.size(), b.first.front()};
+    });
+    for (auto& [c, sk] : clusters) {
+      const auto w = static_cast<std::uint32_t>(skeletons.size());
+      for (std::uint32_t s : c) strand_wisp_[s] = w;
+      const auto first = static_cast<std::uint32_t>(sys_.rest_x.size());
+      for (std::size_t j = 0; j < sk.x.size(); ++j) {
+        sys_.rest_x.push_back(sk.x[j]);
+        sys_.pinned.push_back(sk.pinned[j]);
+        sys_.seg_mass.push_back(j > 0 ? static_cast<float>(sk.hair[j - 1]) : 0.0f);
       }
-      for (std::uint32_t s : c) strand_wisp_[s] = static_cast<std::uint32_t>(members.size());
-      sys_.node_begin.push_back(static_cast<std::uint32_t>(sys_.rest_x.size()));
+      sys_.node_begin.push_back(first + static_cast<std::uint32_t>(sk.x.size()));
       sys_.wisp_params.push_back(key.first);
-      members.push_back(std::move(c));
+      skeletons.push_back(std::move(sk));
     }
   }
   sys_.r_rest.assign(sys_.rest_x.size(), 0.0f);
   sys_.resize_state();
   for (std::size_t w = 0; w < sys_.wisp_count(); ++w) k::wisp_init_rest(sys_, w, root_blend);
 
-  // §3.4/§5.2: each strand vertex gets fixed coordinates in its wisp's sections
-  // (kernels::strand_coord). A section's rest radius is the circle holding every strand
-  // point interpolated from it (§5.2: points "in a circle"), so strands start inside.
+  // §3.4/§5.2: each strand vertex gets fixed coordinates in its wisp's section through
+  // its skeleton point (skeleton_of; kernels::strand_coord). A section's rest radius is
+  // the circle holding every strand point interpolated from it (§5.2: points "in a
+  // circle"), so strands start inside.
   coord_.assign(rest.vertex_count(), Vec4f::Zero());
+  vertex_node_.assign(rest.vertex_count(), 0);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
     const std::uint32_t w = strand_wisp_[s];
+    const Skeleton& sk = skeletons[w];
     for (std::uint32_t i = 0; i < rest.strand_size(s); ++i) {
-      const std::uint32_t node = sys_.node_begin[w] + i;
-      const Vec4f c = k::strand_coord(sys_, w, node, xyz(rest.positions[rest.strand_begin(s) + i]), Eigen::Matrix3f::Identity());
-      coord_[rest.strand_begin(s) + i] = c;
+      const std::uint32_t v = rest.strand_begin(s) + i, node = sys_.node_begin[w] + sk.vertex_node[i];
+      const Vec4f c = k::strand_coord(sys_, node, sk.vertex_u[i], xyz(rest.positions[v]), Eigen::Matrix3f::Identity());
+      coord_[v] = c;
+      vertex_node_[v] = node;
       const float radius = std::hypot(c.y(), c.z());
       sys_.r_rest[node] = std::max(sys_.r_rest[node], radius);
-      if (c.x() != 0.0f) {
-        const std::uint32_t j = c.x() > 0.0f ? node + 1 : node - 1;
-        sys_.r_rest[j] = std::max(sys_.r_rest[j], radius);
-      }
+      if (c.x() != 0.0f) sys_.r_rest[node + 1] = std::max(sys_.r_rest[node + 1], radius);
     }
   }
 }
@@ -252,9 +471,9 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
   interaction_hz_ = params.get("interaction_hz");
   threads_min_wisps_ = params.get_int("threads_min_wisps");
 
-  cluster(rest, params.get_int("wisps"), params.get_int("strands_per_wisp"), params.get_int("root_blend"),
-          static_cast<float>(params.get("wisp_width_max")));
   const float r_min = static_cast<float>(params.get("wisp_radius_min"));
+  cluster(rest, params.get_int("wisps"), params.get_int("strands_per_wisp"), params.get_int("skeleton_segments"),
+          params.get_int("root_blend"), static_cast<float>(params.get("wisp_width_max")), r_min);
   for (float& r : sys_.r_rest) r = std::max(r, r_min);
   for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
   // Blocks of the fused schedule: consecutive wisps of one node count and params set
@@ -674,13 +893,11 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
 // section's origin is the skeleton, its axes and scale factors come from the four
 // envelope masses (kernels::strand_point).
 //
-// A strand's pinned vertices follow the head, but they lie up to half a segment ahead of
-// or behind the wisp's pinned nodes along its axis (the wisp's nodes are its strands'
-// mean vertices): when the wisp's first free segment turns by an angle about its pinned
-// node, the section point of a pinned vertex turns with it while the vertex does not,
-// and, left alone, the first free edge would change length by up to half a segment
-// times that angle (0.5-1.4 of its rest length on ponytail, spin_fast,
-// tilt_upside_down, wind_gust).
+// A strand's pinned vertices follow the head, but their section points need not: a
+// vertex pinned where its wisp's skeleton is free (its wisp's other strands are not
+// pinned there), or lying off its wisp's pinned segment, has its section point turn with
+// the wisp's first free segment while the vertex does not, and, left alone, the first
+// free edge would change length by up to the gap times that angle.
 // The gap between the last pinned vertex and its section point (`anchor`) is carried
 // by the free vertices, fading with the section weight that already blends the axes
 // near the root (root_blend), so the strand stays attached to its root.
@@ -698,18 +915,18 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
   }
   auto body = [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
-      const std::uint32_t nb = sys_.node_begin[strand_wisp_[s]];
       const std::uint32_t vb = rest_.strand_begin(s);
       const std::uint32_t n = rest_.strand_size(s);
+      const std::uint32_t* node = &vertex_node_[vb];
       auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
       if (per_node && n > 0)
-        block_.strand_points(sys_, node_sections_.data(), nb, &coord_[vb], n, &strand_points_[vb],
+        block_.strand_points(sys_, node_sections_.data(), node, &coord_[vb], n, &strand_points_[vb],
                              &strand_weights_[vb]);
       auto point = [&](std::uint32_t i) {
-        return per_node ? strand_points_[vb + i] : k::strand_point(sys_, nb + i, coord_[vb + i], head_rot);
+        return per_node ? strand_points_[vb + i] : k::strand_point(sys_, node[i], coord_[vb + i], head_rot);
       };
       auto weight = [&](std::uint32_t i) {
-        return per_node ? strand_weights_[vb + i] : k::section_weight(sys_, nb + i, coord_[vb + i].x());
+        return per_node ? strand_weights_[vb + i] : k::section_weight(sys_, node[i], coord_[vb + i].x());
       };
       // Root to tip, each free vertex anchored to the last pinned one before it ...
       Vec3f anchor = Vec3f::Zero();

@@ -42,9 +42,10 @@ class PlanteWispModel final : public HairModel {
   const kernels::WispSystem& wisps() const { return sys_; }
   kernels::WispSystem& wisps() { return sys_; }
   // Wisp of each groom strand, and each groom vertex's coordinates in its wisp
-  // (kernels::strand_coord, relative to the node of the same index).
+  // (kernels::strand_coord, relative to node section_nodes()[vertex]).
   std::span<const std::uint32_t> strand_wisp() const { return strand_wisp_; }
   std::span<const Vec4f> section_coords() const { return coord_; }
+  std::span<const std::uint32_t> section_nodes() const { return vertex_node_; }
   // Rebuilds positions() from the current wisp state under head transform `head` (done
   // at the end of every step; public so that tests can rebuild from an edited state).
   void rebuild(const Affine3f& head);
@@ -56,7 +57,8 @@ class PlanteWispModel final : public HairModel {
   std::size_t block_wisps() const;
 
  private:
-  void cluster(const Groom& rest, int wisps, int strands_per_wisp, int root_blend, float width_max);
+  void cluster(const Groom& rest, int wisps, int strands_per_wisp, int segments, int root_blend, float width_max,
+               float r_min);
   // The stages a fused pass over the wisps times (see wisp_pass).
   enum PassStage { kIntegration = 0, kBody = 1 };
   struct WispClock {
@@ -106,7 +108,8 @@ class PlanteWispModel final : public HairModel {
   std::vector<RunRange> run_ranges_;
   kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();  // and the narrow phase
   std::vector<std::uint32_t> strand_wisp_;
-  std::vector<Vec4f> coord_;  // per groom vertex
+  std::vector<Vec4f> coord_;              // per groom vertex
+  std::vector<std::uint32_t> vertex_node_;  // per groom vertex: the node coord_ is relative to
   std::vector<Vec4f> pos_;
   // The rebuild's (plante_wisp): per node, and each vertex's section point and weight.
   std::vector<kernels::NodeSection> node_sections_;
