@@ -7,8 +7,8 @@
 //  - Han & Harada's methods are position-based and unconditionally stable: never diverged
 //    or unstable, and ok with the head still;
 //  - a near-degenerate edge is rounding-sized: it changes no model's verdict;
-//  - the cascade's reference springs make its rest state unstable on long strands (32 and
-//    64 nodes), with a positive growth rate, and not on 4-node strands.
+//  - the cascade's reference springs, halves of torsion springs, make its rest state
+//    stable at every strand length (4, 32 and 64 nodes).
 // And for every built-in scenario, skipping (inert stages, sleep) changes no verdict.
 #include "core/parallel.h"
 #include "harness/probe.h"
@@ -150,12 +150,7 @@ TEST(Gauntlet, VerdictsFollowThePhysicsNotTheNumbers) {
           }
         }
         if (r.model == "halen_cascade" && !shake) {
-          if (vertices >= 32) {
-            EXPECT_EQ(status, verdict::Status::unstable) << r.verdict.reason;
-            EXPECT_GT(r.verdict.probe.rate, ProbeSettings::kMinGrowthRate);
-          } else {
-            EXPECT_NE(status, verdict::Status::unstable) << r.verdict.reason;
-          }
+          EXPECT_NE(status, verdict::Status::unstable) << r.verdict.reason;
         }
       }
     }

@@ -16,13 +16,10 @@ namespace {
 using metrics::EnergyGrowthCheck;
 constexpr int kFramesToFail = EnergyGrowthCheck::kWindow * (EnergyGrowthCheck::kWindows + 1);
 
-// The models the verdicts find unstable on some of these grooms (docs/verdicts.md):
-// Halén & Wester's cascade (its reference springs act on one node only: the probe grows on
-// every 16-vertex groom), the forest (explicit joint integration where strands crowd or
-// start inside a collider), and the layered wisps, whose unit-mass skeleton keeps gaining
-// kinetic energy after the shake on the vertical and the collider-crossing grooms.
+// The models the verdicts find unstable on some of these grooms (docs/verdicts.md): the
+// forest (explicit joint integration where strands crowd or start inside a collider).
 bool known_unstable(const std::string& model) {
-  for (const char* m : {"halen_cascade", "halen_forest", "plante_wisp"})
+  for (const char* m : {"halen_forest"})
     if (model.rfind(m, 0) == 0) return true;
   return false;
 }
@@ -71,6 +68,13 @@ TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
     } else if (known_unstable(d.model)) {
       // Reported as unstable where they are (known_unstable), never as a blow-up.
       EXPECT_TRUE(d.status == "ok" || d.status == "unstable") << d.status;
+    } else if (d.model.rfind("plante_wisp", 0) == 0 && d.name == "inside_collider") {
+      // The layered wisps' first body detection moves the skeleton masses that start
+      // inside the collider out onto its surface (§4.2), wrapping the skeleton round it;
+      // its bending springs then throw it off within a frame, and the strands rebuilt on
+      // the skeleton folded over pass the 50% bound for a few frames
+      // (docs/limitations.md). It settles, never blows up.
+      EXPECT_TRUE(d.status == "ok" || d.status == "stretched") << d.status;
     } else {
       EXPECT_EQ(d.status, "ok");  // these are valid grooms: every model must cope
     }
@@ -93,7 +97,7 @@ TEST(Stress, ShortSetEscalatesUntilFailureAndKeepsTheBaseStable) {
       // A failure always says why; a stable cell never carries a reason.
       EXPECT_EQ(c.stable, c.reason.empty());
       // The base scenario's own time step (1/60 s) is where every model is stable, but
-      // for the cascade, whose rest state is unstable at any step (docs/verdicts.md).
+      // for those known to be unstable on some grooms (known_unstable).
       if (a.axis == "time_step" && c.value == 1.0 / 60) {
         if (known_unstable(a.model)) {
           EXPECT_TRUE(c.stable || c.reason.rfind("unstable:", 0) == 0) << c.reason;

@@ -133,12 +133,21 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
       r.tz[o + l] = free ? a * A[2 * W + l] + b * Y[2 * W + l] : 0.0f;
     }
   }
-  alignas(64) float pax[W] = {}, pay[W] = {}, paz[W] = {};  // the parent's absolute acceleration
+  // The parent's absolute acceleration, the head's (or zero) until the first free segment.
+  alignas(64) float pax[W], pay[W], paz[W];
+  LANES {
+    pax[l] = h.root_angular[0];
+    pay[l] = h.root_angular[1];
+    paz[l] = h.root_angular[2];
+  }
+  const bool compensate = f.gravity_compensation;
+  // What turns a torque per unit mass into an angular acceleration (ForestInertia): 1/ℓ
+  // (one row after the fields) or the segment's length.
   const float* inv_len = r.c + static_cast<std::size_t>(kForestFields) * fs;
   for (int i = 1; i < n; ++i) {
     if (r.kind[i] == kRowPinned) continue;
     const int o = i * W;
-    const float* iw = r.field(FIW, i);
+    const float *iw = r.field(FIW, i), *gain = f.mass_inertia ? r.field(FLEN, i) : inv_len;
     const float* R2 = r.field(FR6, i);  // rest frame's z column
     const float *A = r.frame(i - 1, 3 * prim), *Y = r.frame(i, 3), *Z = r.frame(i, 6);
     const bool child = i + 1 < n;
@@ -180,14 +189,15 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
     }
     LANES {
       const float zx = Z[l], zy = Z[W + l], zz = Z[2 * W + l];
-      // Gravity's torque on the head-transformed rest segment, subtracted.
+      // Gravity's torque on the head-transformed rest segment, subtracted where compensating.
       const float rzx = m0 * R2[l] + m1 * R2[fs + l] + m2 * R2[2 * fs + l];
       const float rzy = m3 * R2[l] + m4 * R2[fs + l] + m5 * R2[2 * fs + l];
       const float rzz = m6 * R2[l] + m7 * R2[fs + l] + m8 * R2[2 * fs + l];
-      const float il = inv_len[l];
-      const float cx = (zy * az[l] - zz * ay[l]) - (rzy * gz - rzz * gy);
-      const float cy = (zz * ax[l] - zx * az[l]) - (rzz * gx - rzx * gz);
-      const float cz = (zx * ay[l] - zy * ax[l]) - (rzx * gy - rzy * gx);
+      const float il = gain[l];
+      const float tx = zy * az[l] - zz * ay[l], ty = zz * ax[l] - zx * az[l], tz = zx * ay[l] - zy * ax[l];
+      const float cx = compensate ? tx - (rzy * gz - rzz * gy) : tx;
+      const float cy = compensate ? ty - (rzz * gx - rzx * gz) : ty;
+      const float cz = compensate ? tz - (rzx * gy - rzy * gx) : tz;
       float accx = il * cx - r.tx[o + l], accy = il * cy - r.ty[o + l], accz = il * cz - r.tz[o + l];
       if (child) {
         accx += ntx[l];

@@ -56,31 +56,41 @@ void spring_setup(std::span<const Vec4f> rest, float stiffness, float c, int exp
 }
 
 void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, float down_fraction,
-                   std::span<float> k_up, std::span<float> k_down, std::span<Mat3f> rest_space,
-                   std::span<Vec3f> up_local, std::span<Vec3f> down_local, std::span<float> lift) {
+                   CascadeFrames frames, std::span<float> inv_mass, std::span<float> k_up,
+                   std::span<float> k_down, std::span<float> lift, std::span<int> base, std::span<float> lever,
+                   std::span<Mat3f> rest_space, std::span<Vec3f> up_local, std::span<Vec3f> down_local) {
   const std::size_t n = rest.size();
-  std::vector<float> arc(n);
+  std::vector<float> arc(n), edge(n, 0.0f);
   arc_lengths(rest, arc);
+  for (std::size_t i = 1; i < n; ++i) edge[i] = arc[i] - arc[i - 1];
+  std::vector<float> sorted(edge.begin() + 1, edge.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const float tiny = 1e-3f * sorted[sorted.size() / 2];
   for (std::size_t i = 0; i < n; ++i) {
-    k_up[i] = k_down[i] = lift[i] = 0.0f;
+    inv_mass[i] = rest[i].w();
+    k_up[i] = k_down[i] = lift[i] = lever[i] = 0.0f;
+    base[i] = -1;
     up_local[i] = down_local[i] = Vec3f::Zero();
   }
-  for (std::size_t i = 2; i < n; ++i) {
+  inv_mass[1] = n > 2 ? rest[2].w() : 1.0f;
+  for (std::size_t j = 1; j < n; ++j) {
+    const int b = edge[j] < tiny ? base[j - 1] : static_cast<int>(j) - 1;
+    base[j] = b;
+    if (b >= 0) lever[j] = (xyz(rest[j]) - xyz(rest[static_cast<std::size_t>(b)])).norm();
+  }
+  for (std::size_t i = 1; i < n; ++i) {
     k_up[i] = falloff_stiffness(stiffness, arc[i], c, exponent);
     // Only nodes with a segment two below them have a downward reference node.
     if (i + 2 < n) k_down[i] = down_fraction * k_up[i];
-  }
-  const Vec3f root_dir = (xyz(rest[1]) - xyz(rest[0])).normalized();
-  tangent_spaces(rest, root_tangent_space(root_dir), rest_space);
-  // §4.3: the reference nodes are the rest positions of the nodes in the tangent spaces
-  // of the rest shape, displaced upward so that their springs carry the node's weight:
-  // L = mg/k, and with an upward and a downward node both by mg/(k_up + k_down) ("half
-  // the distance" when the two are equally strong). The displacement is along world up,
-  // so the head-transformed rest shape is in equilibrium in any head pose.
-  auto p = [&](std::size_t i) -> Vec3f { return xyz(rest[i]); };
-  for (std::size_t i = 2; i < n; ++i) {
     const float ksum = k_up[i] + k_down[i];
     lift[i] = ksum > 0.0f ? 1.0f / ksum : 0.0f;
+  }
+  const Vec3f root_dir = (xyz(rest[1]) - xyz(rest[0])).normalized();
+  tangent_spaces(rest, root_tangent_space(root_dir), frames, base, rest_space);
+  // §4.3: the reference nodes are the rest positions of the nodes in the tangent spaces
+  // of the rest shape.
+  auto p = [&](std::size_t i) -> Vec3f { return xyz(rest[i]); };
+  for (std::size_t i = 1; i < n; ++i) {
     up_local[i] = rest_space[i - 1].transpose() * (p(i) - p(i - 1));
     if (i + 2 < n) down_local[i] = rest_space[i + 2].transpose() * (p(i) - p(i + 2));
   }
@@ -98,39 +108,82 @@ Mat3f root_tangent_space(const Vec3f& n) {
   return m;
 }
 
-void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, std::span<Mat3f> space) {
+void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, CascadeFrames frames,
+                    std::span<const int> base, std::span<Mat3f> space) {
   space[0] = root;
-  space[1] = root;
-  for (std::size_t i = 2; i < pos.size(); ++i) {
-    const Vec3f d = xyz(pos[i]) - xyz(pos[i - 1]);
+  for (std::size_t j = 1; j < pos.size(); ++j) {
+    const Mat3f& parent = space[j - 1];
+    const Vec3f d = xyz(pos[j]) - xyz(pos[j - 1]);
     const float len = d.norm();
-    const Mat3f& parent = space[i - 1];
-    if (!(len > 0.0f)) {
-      space[i] = parent;
+    if (base[j] != static_cast<int>(j) - 1 || !(len > 0.0f)) {
+      space[j] = parent;
       continue;
     }
     const Vec3f n = d / len;
-    Vec3f b = n.cross(parent.col(2));
-    const float bl = b.norm();
-    if (bl > 1e-6f)
-      b /= bl;
-    else
-      b = (parent.col(0) - parent.col(0).dot(n) * n).normalized();
-    space[i].col(0) = b;
-    space[i].col(1) = n;
-    space[i].col(2) = n.cross(b);
+    Vec3f b;
+    bool ok;
+    if (frames == CascadeFrames::Cross) {
+      b = n.cross(parent.col(2));
+      const float bl = b.norm();
+      ok = bl > 1e-6f;
+      if (ok) b /= bl;
+    } else {
+      // Rodrigues' formula for the rotation about a = N_{j-1} × N_j by the angle between
+      // them: v -> c v + a × v + (a·v) a / (1 + c), c = N_{j-1}·N_j.
+      const Vec3f n0 = parent.col(1);
+      const float c = n0.dot(n);
+      ok = c > -0.999f;
+      if (ok) {
+        const Vec3f a = n0.cross(n);
+        const Vec3f b0 = parent.col(0);
+        b = c * b0 + a.cross(b0) + (a.dot(b0) / (1.0f + c)) * a;
+        b = (b - b.dot(n) * n).normalized();
+      }
+    }
+    if (!ok) b = (parent.col(0) - parent.col(0).dot(n) * n).normalized();
+    space[j].col(0) = b;
+    space[j].col(1) = n;
+    space[j].col(2) = n.cross(b);
   }
 }
 
-void cascade_references(std::span<const Vec4f> pos, std::span<const Mat3f> space,
-                        std::span<const Vec3f> up_local, std::span<const Vec3f> down_local,
-                        std::span<const float> lift, const Vec3f& gravity, std::span<Vec3f> up_ref,
-                        std::span<Vec3f> down_ref) {
+namespace {
+// One reference spring of cascade_accelerations: vertex i towards the node `local` of
+// space j.
+void reference_spring(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
+                      bool reactions, const Vec3f& head_gravity, std::size_t i, std::size_t j,
+                      const Vec3f& local, float k, std::span<Vec3f> acc) {
+  const Mat3f& m = space[j];
+  const Vec3f d = m * local;
+  // The stretch from the offsets (d and P_i - P_j, a segment or two long), not from the
+  // positions themselves: its rounding is that of the strand's scale, not the head's.
+  const Vec3f elastic = k * (d - (xyz(pos[i]) - xyz(pos[j])));
+  if (s.inv_mass[i] != 0.0f) acc[i] += elastic - (k * s.lift[i]) * head_gravity;
+  const int a = s.base[j];
+  if (!reactions || a < 0) return;
+  const Vec3f r = -elastic;
+  const Vec3f fa = (m.col(1).dot(r) * d - local.y() * r) / s.lever[j];
+  if (s.inv_mass[j] != 0.0f) acc[j] += r - fa;
+  if (s.inv_mass[static_cast<std::size_t>(a)] != 0.0f) acc[static_cast<std::size_t>(a)] += fa;
+}
+}  // namespace
+
+void cascade_accelerations(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
+                           bool reactions, const Vec3f& gravity, const Vec3f& head_gravity, std::span<Vec3f> acc) {
   const std::size_t n = pos.size();
-  for (std::size_t i = 2; i < n; ++i)
-    up_ref[i] = space[i - 1] * up_local[i] + xyz(pos[i - 1]) - gravity * lift[i];
-  for (std::size_t i = 0; i + 2 < n; ++i)
-    down_ref[i] = space[i + 2] * down_local[i] + xyz(pos[i + 2]) - gravity * lift[i];
+  for (std::size_t i = 0; i < n; ++i) acc[i] = gravity;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (j + 1 < n)
+      reference_spring(pos, space, s, reactions, head_gravity, j + 1, j, s.up_local[j + 1], s.k_up[j + 1], acc);
+    if (j >= 3)
+      reference_spring(pos, space, s, reactions, head_gravity, j - 2, j, s.down_local[j - 2], s.k_down[j - 2], acc);
+  }
+}
+
+void add_acceleration(std::span<Vec4f> pos, std::span<const Vec3f> acc, float dt) {
+  const float dt2 = dt * dt;
+  for (std::size_t i = 0; i < pos.size(); ++i)
+    if (pos[i].w() != 0.0f) pos[i].head<3>() += dt2 * acc[i];
 }
 
 namespace {
@@ -207,6 +260,11 @@ Mat34f root_inertia(const Affine3f& head, const Affine3f& h1, const Affine3f& h0
   return (second * head.inverse(Eigen::Isometry).matrix()).topRows<3>() / (dt * dt);
 }
 
+Vec3f head_angular_acceleration(const Affine3f& head, const Affine3f& h1, const Affine3f& h0, float dt) {
+  const Mat3f m = (head.linear() - 2.0f * h1.linear() + h0.linear()) * h1.linear().transpose() / (dt * dt);
+  return 0.5f * Vec3f(m(2, 1) - m(1, 2), m(0, 2) - m(2, 0), m(1, 0) - m(0, 1));
+}
+
 void forest_pose(const ForestStrand& s, ForestAxes axes, const Affine3f& head) {
   const Mat3f head_rotation = head.linear();
   const std::size_t n = s.pos.size();
@@ -261,16 +319,17 @@ void forest_integrate(const ForestStrand& s, ForestAxes axes, const ForestForces
     s.joint_torque[i] = (s.k[i] * (s.theta[i] - s.theta0[i]) + f.joint_damping * s.dtheta[i]) * a +
                         (s.k[i] * (s.phi[i] - s.phi0[i]) + f.joint_damping * s.dphi[i]) * y;
   }
-  Vec3f parent_acc = Vec3f::Zero();  // the head-rigid root: its motion is in f.inertia
+  Vec3f parent_acc = f.root_angular_acceleration;
   for (std::size_t i = 1; i < n; ++i) {
     if (s.rest[i].w() == 0.0f) continue;
     const Vec3f z = s.frame[i].col(2);
     const Vec3f p = xyz(s.pos[i]);
-    const Vec3f rest_z = f.head_rotation * s.rest_frame[i].col(2);
-    // Eq. 4.2.1 and 4.2.3: external torque less gravity's torque on the rest segment,
-    // minus the joint's own spring, plus its child's.
-    Vec3f acc = f.inv_inertia_length * (z.cross(external_acceleration(f, p, z)) - rest_z.cross(f.gravity)) -
-                s.joint_torque[i];
+    // Eq. 4.2.1, 4.2.4 and 4.2.3: the external torque (less gravity's on the rest
+    // segment) as an angular acceleration, minus the joint's own spring, plus its child's.
+    Vec3f torque = z.cross(external_acceleration(f, p, z));
+    if (f.gravity_compensation) torque -= (f.head_rotation * s.rest_frame[i].col(2)).cross(f.gravity);
+    const float gain = f.inertia_model == ForestInertia::Mass ? s.length[i] : f.inv_inertia_length;
+    Vec3f acc = gain * torque - s.joint_torque[i];
     if (i + 1 < n) acc += s.joint_torque[i + 1];
     // Eq. 4.2.5: relative to the parent, projected on the joint axes.
     const Vec3f rel = acc - parent_acc;

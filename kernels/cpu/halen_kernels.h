@@ -43,18 +43,43 @@ void add_spring_acceleration(std::span<Vec4f> pos, std::span<const Vec4f> prev, 
 
 // ---- set-up of the spring models, shared by the reference and the fused models --------
 
+// How a segment's tangent space takes B and T from its parent's (§4.3; "there is no one
+// way of defining the binormal and the tangent").
+enum class CascadeFrames : int {
+  // The thesis's: B_j = N_j × T_{j-1} (normalised), T_j = N_j × B_j. Undefined where
+  // N_j is parallel to T_{j-1}, a bend of 90° towards T: near it a small turn of the
+  // segment spins the space about N (there the parent's B, made perpendicular to N_j,
+  // is kept).
+  Cross = 0,
+  // The parent's space turned by the smallest rotation that takes N_{j-1} to N_j
+  // (parallel transport): B and T turn with the segment, undefined only where the
+  // strand folds back on itself (there, too, the parent's B is kept).
+  Transport = 1,
+};
+
 // §4.4 with §5.9's falloff, one strand: the spring strength k_L of every vertex and its
 // reference node's lift 1/k_L (L = mg/k per unit mass; 0 where k_L is 0).
 void spring_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, std::span<float> k,
                   std::span<float> lift);
 
-// §4.3 with §5.9's falloff and downward fraction, one strand: the upward (vertices 2..n)
-// and downward (vertices with a segment two below them) spring strengths, the rest
-// tangent spaces, the reference nodes in them and the lift 1/(k_up + k_down) they share.
+// §4.3 with §5.9's falloff and downward fraction, one strand. The thesis fixes only node 0
+// to the scalp; node 1 is simulated, with its upward reference node in the given tangent
+// space at the root. Writes:
+//  - inv_mass: the groom's inverse masses with vertex 1 freed (it takes vertex 2's, 1 on a
+//    two-vertex strand); a groom that pins vertex 2 as well keeps vertex 1 pinned;
+//  - k_up (vertices 1..n) and k_down (vertices 1.. with a segment two below them), the
+//    lift 1/(k_up + k_down) per unit gravity (L = mg/k with both reference nodes
+//    displaced alike, "half the distance" when they are equally strong);
+//  - base and lever: the rigid segment that carries space j is (base[j], j), lever[j] long
+//    at rest; base[j] = j-1 but where segment j is rounding-sized (under 1/1000 of the
+//    strand's median rest edge: its direction is rounding noise), which takes its
+//    parent's space and joins its rigid segment; -1 where the space is the head's;
+//  - the rest tangent spaces (space[0] the root's) and the reference nodes in them.
 // Entries a vertex has no use for are 0.
 void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, float down_fraction,
-                   std::span<float> k_up, std::span<float> k_down, std::span<Mat3f> rest_space,
-                   std::span<Vec3f> up_local, std::span<Vec3f> down_local, std::span<float> lift);
+                   CascadeFrames frames, std::span<float> inv_mass, std::span<float> k_up,
+                   std::span<float> k_down, std::span<float> lift, std::span<int> base, std::span<float> lever,
+                   std::span<Mat3f> rest_space, std::span<Vec3f> up_local, std::span<Vec3f> down_local);
 
 // ---- cascading spaces (§4.3) ----------------------------------------------------------
 
@@ -64,21 +89,48 @@ void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int ex
 // point on the scalp is given") for a root segment along the unit vector n.
 Mat3f root_tangent_space(const Vec3f& n);
 
-// §4.3: the tangent spaces from the root up. space[1] (segment 0-1, rigid with the head)
-// is `root`; for n >= 2, N_n = (P_n - P_{n-1}) / |.|, B_n = N_n × T_{n-1} (normalised),
-// T_n = N_n × B_n. space[0] is not used. Where N_n is parallel to T_{n-1} the cross
-// product vanishes and B_{n-1}, then perpendicular to N_n, is kept.
-void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, std::span<Mat3f> space);
+// §4.3: the tangent spaces from the root up. space[0] is the given space at the scalp,
+// `root`; the segment ending at vertex j >= 1 has N_j = (P_j - P_{j-1}) / |.| and B, T
+// from its parent's space, by `frames` (CascadeFrames). A segment with base[j] != j-1
+// (cascade_setup) or of zero length keeps its parent's space.
+void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, CascadeFrames frames,
+                    std::span<const int> base, std::span<Mat3f> space);
 
-// §4.3: P_world = M P + O_T with O_T the segment's second node, then displaced upward
-// against gravity by lift_i (L = mg/k per unit mass, shared by both reference nodes of a
-// vertex). The upward reference node of vertex i lives in the space of segment i-1
-// (origin P_{i-1}), i >= 2; the downward one in the space of segment i+2 (origin
-// P_{i+2}), i + 2 < n. Writes up_ref[2..n) and down_ref[0..n-2).
-void cascade_references(std::span<const Vec4f> pos, std::span<const Mat3f> space,
-                        std::span<const Vec3f> up_local, std::span<const Vec3f> down_local,
-                        std::span<const float> lift, const Vec3f& gravity, std::span<Vec3f> up_ref,
-                        std::span<Vec3f> down_ref);
+// One strand's constant set-up (cascade_setup), as cascade_accelerations reads it.
+struct CascadeStrand {
+  std::span<const float> inv_mass;      // the cascade's own: vertex 1 free
+  std::span<const float> k_up, k_down;  // per unit node mass, s^-2
+  std::span<const float> lift;          // per unit gravity
+  std::span<const int> base;
+  std::span<const float> lever;
+  std::span<const Vec3f> up_local, down_local;
+};
+
+// §4.3's reference springs as accelerations (per unit node mass), from the positions and
+// spaces at the start of the step. Space j (origin P_j, P_0 for the root's) carries the
+// upward reference node of vertex j+1 and the downward one of vertex j-2 (j >= 3). A
+// zero-rest-length spring F = kL pulls its vertex P towards the reference node M w + O_T
+// (w its rest offset in the space), displaced against gravity, in two parts:
+//  - elastic, k (M w + O_T - P): the half of the torsion spring that §4.3 says the
+//    reference nodes simulate. With `reactions` it pushes back on the segment that
+//    carries the space, as a force R = -F at the reference node on a rigid segment
+//    (A = base[j], O = j): f_A = ((N·R) d - (N·d) R) / ℓ on A and R - f_A on O, d the
+//    node's offset from O, N the segment's direction and ℓ = lever[j], the split that
+//    gives the segment R's force and its torque across N. Without, the reference node
+//    is fixed during the step, as the thesis has it;
+//  - the displacement's share, k·lift·(-g_h) with g_h = `head_gravity`, gravity turned by
+//    the head (§4.4: the displaced position is "kept static in relation to the base"): at
+//    rest it carries the node's weight, mg, from the head.
+// Gravity is added here too, so that at rest it meets the displacement's share in one sum
+// (added to a position apart, the two would each round the position, and the roundings
+// of a moving strand do not cancel). Pinned vertices take nothing. Accumulated from
+// gravity, space by space, upward then downward.
+void cascade_accelerations(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
+                           bool reactions, const Vec3f& gravity, const Vec3f& head_gravity, std::span<Vec3f> acc);
+
+// p += dt² acc for the free vertices: gravity and the reference springs as the force term
+// of Verlet (Eq. 4.1), after verlet_integrate (run without gravity).
+void add_acceleration(std::span<Vec4f> pos, std::span<const Vec3f> acc, float dt);
 
 // ---- the interactive forest (§4.2, after Di Giacomo et al. 2001, and §5.9) ------------
 
@@ -121,6 +173,10 @@ float forest_setup(std::span<const Vec4f> rest, ForestAxes axes, float stiffness
 // differences of the head transform over three substeps dt apart (h0, h1, head):
 // (H - 2H_1 + H_0) H^-1 p / dt².
 Mat34f root_inertia(const Affine3f& head, const Affine3f& h1, const Affine3f& h0, float dt);
+// The head's angular acceleration Ω̇_H at the middle substep, by the same central
+// differences: R''R^T = [Ω̇_H]× + [Ω_H]×², whose antisymmetric part is [Ω̇_H]×, with R
+// the rotation of h1.
+Vec3f head_angular_acceleration(const Affine3f& head, const Affine3f& h1, const Affine3f& h0, float dt);
 
 // Rest angles and frames of one strand (head at identity), from its rest polyline.
 void forest_rest(std::span<const Vec4f> rest, ForestAxes axes, std::span<Mat3f> rest_frame,
@@ -130,30 +186,44 @@ void forest_rest(std::span<const Vec4f> rest, ForestAxes axes, std::span<Mat3f> 
 // are exact; pinned vertices and their segments follow the head rigidly.
 void forest_pose(const ForestStrand& s, ForestAxes axes, const Affine3f& head);
 
+// The inertia J of Eq. 4.2.4 that turns an external torque τ = L z × F (Eq. 4.2.1, F = m a)
+// into an angular acceleration. Mass: Di Giacomo et al.'s J ≈ mI, so Ω̇ = τ / m = L z × a
+// (lengths in metres). StrandPendulum: J = m L ℓ I with ℓ the strand's length, so
+// Ω̇ = z × a / ℓ and a straight strand swings under gravity like a pendulum of length ℓ,
+// whatever its segment count.
+enum class ForestInertia : int { Mass = 0, StrandPendulum = 1 };
+
 struct ForestForces {
   Vec3f gravity = Vec3f::Zero();
   Wind wind;
   // Acceleration of a point rigid with the head, a(p) = inertia · (p, 1): its negative is
-  // the inertial force of the moving root on a segment end.
+  // the inertial force of the moving root on a segment end (§4.2: "to approximate inertia
+  // when the root has changed direction and speed, forces are added").
   Mat34f inertia = Mat34f::Zero();
   Mat3f head_rotation = Mat3f::Identity();
   std::span<const Vec4f> spheres;  // world xyz + radius
   float collision_stiffness = 0.0f;  // fraction of the penetration depth removed per dt²
   float joint_damping = 0.0f;        // v of Eq. 4.2.2, s^-1
-  float inv_inertia_length = 0.0f;   // 1 / ℓ, see forest_integrate
+  float inv_inertia_length = 0.0f;   // 1 / ℓ, see ForestInertia
   float dt = 0.0f;
+  ForestInertia inertia_model = ForestInertia::StrandPendulum;
+  // Subtract gravity's torque on the head-transformed rest segment, so that pose is in
+  // equilibrium (the forest's counterpart of the spring models' L = mg/k; not in §4.2,
+  // where gravity bends the strand until the joint springs hold it).
+  bool gravity_compensation = true;
+  // Ω̇_p of Eq. 4.2.5 for the first free segment, whose parent is rigid with the head:
+  // head_angular_acceleration, or zero to leave the head's motion to the inertial force.
+  Vec3f root_angular_acceleration = Vec3f::Zero();
 };
 
 // One explicit Euler step of the joint angles (Eq. 4.2.1-4.2.6) from the pose in s.frame
 // and s.pos. External forces per unit mass at each segment end (gravity, wind normal to
 // the segment, the root's inertia, sphere penalty forces) become torques τ = L z × F
-// (4.2.1); with J = m L ℓ I (J ≈ mI of Eq. 4.2.4, with the scalar of a segment whose
-// torque swings a straight strand like a pendulum of its length ℓ) the angular
-// acceleration of the torque is z × a / ℓ. The joint springs (4.2.2) of a segment and of
-// its child are added (4.2.3), the parent's absolute acceleration subtracted (4.2.5) and
-// the result projected on the joint axes. Gravity compensation, the forest's counterpart
-// of the spring models' L = mg/k: the torque gravity exerts on the head-transformed rest
-// segment is subtracted, so the head-transformed rest pose is in equilibrium.
+// (4.2.1) and, through f.inertia_model's J (4.2.4), angular accelerations, less gravity's
+// on the head-transformed rest segment where f.gravity_compensation is set. The joint
+// springs (4.2.2) of a segment and of its child are added (4.2.3), the parent's absolute
+// acceleration subtracted (4.2.5; f.root_angular_acceleration for the first free
+// segment) and the result projected on the joint axes.
 void forest_integrate(const ForestStrand& s, ForestAxes axes, const ForestForces& f);
 
 }  // namespace hairbench::kernels

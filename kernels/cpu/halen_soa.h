@@ -38,10 +38,12 @@ enum Field : int {
   KD = kSpringFields,  // cascade: the downward springs' k
   UX, UY, UZ,          // cascade: upward reference nodes in their tangent spaces
   DX, DY, DZ,          // cascade: downward reference nodes in their tangent spaces
+  BS,                  // cascade: j - base[j] of the rigid segment carrying space j, 0 = the head's
+  LV,                  // cascade: that segment's rest length (cascade_setup's lever)
   kCascadeFields
 };
-// The cascade keeps the rest tangent space of the root segment ([B N T], 9 rows, column
-// by column) after its fields.
+// The cascade keeps the given tangent space at the root ([B N T], 9 rows, column by
+// column) after its fields.
 inline constexpr int kRootSpaceRows = 9;
 inline constexpr std::size_t block_floats(Model m, int n) {  // Spring or Cascade
   return m == Model::Spring ? static_cast<std::size_t>(kSpringFields * n) * kLanes
@@ -51,9 +53,8 @@ inline constexpr std::size_t block_floats(Model m, int n) {  // Spring or Cascad
 // across frames.
 enum StateField : int { PX, PY, PZ, QX, QY, QZ, kStateFields };  // positions, previous positions
 inline constexpr std::size_t state_floats(int n) { return static_cast<std::size_t>(kStateFields * n) * kLanes; }
-// Per-thread scratch for a block of n vertices: the world-space reference nodes (one set
-// for the spring model, up and down for the cascade).
-inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(6 * n) * kLanes; }
+// Per-thread scratch for a block of n vertices: the cascade's spring accelerations.
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(3 * n) * kLanes; }
 
 // What a row (one vertex of every lane) holds: most rows are all free or all pinned.
 enum RowKind : std::uint8_t { kRowFree, kRowPinned, kRowMixed };
@@ -72,6 +73,8 @@ struct BlockParams {
   float keep;                // 1 - damping
   int length_iterations;
   const float* spring_scale; // spring model: §4.4's tilt factor k_m / k per substep
+  bool reactions;            // cascade: the springs push back on their spaces' segments
+  bool transport;            // cascade: CascadeFrames::Transport (else Cross)
 };
 
 // One substep's head pose and colliders, computed once per step for every block.
@@ -79,6 +82,7 @@ struct Substep {
   float m[9];  // head linear part, row-major
   float t[3];  // head translation
   float dt2;
+  float hg[3];  // cascade: gravity turned by the head (head linear part · gravity)
   const float* spheres;  // world-space x, y, z, r
   int sphere_count;
 };
@@ -118,12 +122,15 @@ struct ForestSubstep {
   float m[9];        // head linear part, row-major
   float t[3];        // head translation
   float inertia[12]; // a(p) = inertia · (p, 1), row-major 3x4
+  float root_angular[3];  // ForestForces::root_angular_acceleration
   const float* spheres;  // world-space x, y, z, r
   int sphere_count;
 };
 // substeps: substep_count of them, then the frame's final head pose.
 struct ForestFrame : soa::BlockFrame<ForestSubstep> {
   bool parent_x;  // ForestAxes::ParentX (else ParentZ)
+  bool mass_inertia;          // ForestInertia::Mass (else StrandPendulum)
+  bool gravity_compensation;  // ForestForces::gravity_compensation
   float dt;
 };
 struct ForestParams {

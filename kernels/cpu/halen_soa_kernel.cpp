@@ -27,8 +27,7 @@ static_assert(W == soa::kRowLanes, "soa_rows.h takes rows of 16 lanes");
 struct Rows {
   int n;
   float *px, *py, *pz, *qx, *qy, *qz;  // positions, previous positions
-  float *ux, *uy, *uz;                 // reference nodes (the cascade's upward ones)
-  float *dx, *dy, *dz;                 // the cascade's downward reference nodes
+  float *ax, *ay, *az;                 // the cascade's spring accelerations
   const float* c;                      // the block's fields
   const RowKind* kind;
   const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
@@ -61,11 +60,12 @@ void follow_head(const Rows& r, const soa::AffinePose h) {
 // its own row, so they run fused on a row while it is in registers: for the spring model
 // the reference node rigid with the head, lifted against gravity (§4.4, head_references)
 // and follow_head; then Verlet with damping (verlet_integrate) from vertex 1, and the
-// zero-rest-length springs towards the reference nodes (add_spring_acceleration), the
-// cascade's upward then downward ones (§4.3): p += (scale k dt²)(ref - p_start). The one
-// read across rows is the wind term's, which sees vertex i-1 as Verlet left it, before its
-// springs: that row is kept aside. Rows whose lanes are all free or all pinned take no
-// per-lane selects.
+// springs: the spring model's zero-rest-length pull towards its reference node
+// (add_spring_acceleration), p += (scale k dt²)(ref - p_start); the cascade's
+// accelerations from cascade_forces (add_acceleration), p += dt² a. The one read across
+// rows is the wind term's, which sees vertex i-1 as Verlet left it, before its springs:
+// that row is kept aside. Rows whose lanes are all free or all pinned take no per-lane
+// selects.
 struct Integration {
   soa::AffinePose h;
   float gx, gy, gz, wx, wy, wz;
@@ -78,9 +78,7 @@ struct Moved {
   alignas(64) float x[W], y[W], z[W];
 };
 
-// kDown: the row has a downward spring (the cascade's rows with a segment two below them);
-// a template argument, as a run-time flag in the lane loop costs a mask built bit by bit.
-template <Model kModel, bool kWindy, RowKind kKind, bool kRoot, bool kDown>
+template <Model kModel, bool kWindy, RowKind kKind, bool kRoot>
 inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
   constexpr bool kSpring = kModel == Model::Spring;
   const soa::AffinePose h = in.h;
@@ -102,9 +100,7 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
     return;
   }
   const float *lift = r.field(LIFT, i), *ku = r.field(KU, i);
-  const float *ux = r.ux + o, *uy = r.uy + o, *uz = r.uz + o;
-  const float* kd = kSpring ? ku : r.field(KD, i);
-  const float *dx = r.dx + o, *dy = r.dy + o, *dz = r.dz + o;
+  const float *cx = r.ax + o, *cy = r.ay + o, *cz = r.az + o;
   LANES {
     const bool free = kKind == kRowFree || iw[l] != 0.0f;
     const float x = px[l], y = py[l], z = pz[l];
@@ -142,25 +138,18 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
       my[l] = ny;
       mz[l] = nz;
     }
-    float ax, ay, az;  // the reference node
     if constexpr (kSpring) {
-      ax = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];
-      ay = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
-      az = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
+      const float ax = h.x(rx[l], ry[l], rz[l]) - gx * lift[l];  // the reference node
+      const float ay = h.y(rx[l], ry[l], rz[l]) - gy * lift[l];
+      const float az = h.z(rx[l], ry[l], rz[l]) - gz * lift[l];
+      const float c = (scale * ku[l]) * dt2;
+      nx = free ? nx + c * (ax - ox) : nx;
+      ny = free ? ny + c * (ay - oy) : ny;
+      nz = free ? nz + c * (az - oz) : nz;
     } else {
-      ax = ux[l];
-      ay = uy[l];
-      az = uz[l];
-    }
-    const float c = (scale * ku[l]) * dt2;
-    nx = free ? nx + c * (ax - ox) : nx;
-    ny = free ? ny + c * (ay - oy) : ny;
-    nz = free ? nz + c * (az - oz) : nz;
-    if constexpr (kDown) {
-      const float cd = (scale * kd[l]) * dt2;
-      nx = free ? nx + cd * (dx[l] - ox) : nx;
-      ny = free ? ny + cd * (dy[l] - oy) : ny;
-      nz = free ? nz + cd * (dz[l] - oz) : nz;
+      nx = free ? nx + dt2 * cx[l] : nx;
+      ny = free ? ny + dt2 * cy[l] : ny;
+      nz = free ? nz + dt2 * cz[l] : nz;
     }
     px[l] = nx;
     py[l] = ny;
@@ -171,34 +160,27 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
   }
 }
 
-template <Model kModel, bool kWindy, bool kRoot, bool kDown>
+template <Model kModel, bool kWindy, bool kRoot>
 inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m) {
   switch (r.kind[i]) {
     case kRowFree:
-      integrate_row<kModel, kWindy, kRowFree, kRoot, kDown>(r, i, in, m);
+      integrate_row<kModel, kWindy, kRowFree, kRoot>(r, i, in, m);
       break;
     case kRowPinned:
-      integrate_row<kModel, kWindy, kRowPinned, kRoot, kDown>(r, i, in, m);
+      integrate_row<kModel, kWindy, kRowPinned, kRoot>(r, i, in, m);
       break;
     default:
-      integrate_row<kModel, kWindy, kRowMixed, kRoot, kDown>(r, i, in, m);
+      integrate_row<kModel, kWindy, kRowMixed, kRoot>(r, i, in, m);
       break;
   }
 }
 
 template <Model kModel, bool kWindy>
 void integrate(const Rows& r, const Integration& in) {
-  constexpr bool kCascade = kModel == Model::Cascade;
   Moved m;
   // The integrator starts at vertex 1.
-  if (r.n > 2)
-    integrate_row<kModel, kWindy, true, kCascade>(r, 0, in, m);
-  else
-    integrate_row<kModel, kWindy, true, false>(r, 0, in, m);
-  const int down_end = kCascade ? r.n - 2 : 1;  // rows [1, down_end) have a downward spring
-  int i = 1;
-  for (; i < down_end; ++i) integrate_row<kModel, kWindy, false, kCascade>(r, i, in, m);
-  for (; i < r.n; ++i) integrate_row<kModel, kWindy, false, false>(r, i, in, m);
+  integrate_row<kModel, kWindy, true>(r, 0, in, m);
+  for (int i = 1; i < r.n; ++i) integrate_row<kModel, kWindy, false>(r, i, in, m);
 }
 
 // Edge length constraints (edge_length): odd edges, then even ones, mass-weighted.
@@ -311,86 +293,177 @@ struct Space {
   alignas(64) float v[9][W];
 };
 
-// A reference node M · local + origin - gravity · lift (cascade_references) into row `out`.
-inline void place(const Space& m, const float* lx, const float* ly, const float* lz, const float* ox,
-                  const float* oy, const float* oz, const float* lift, const Frame& f, float* x, float* y,
-                  float* z) {
-  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
+// One reference spring (cascade_accelerations' reference_spring): vertex i towards the
+// node (lx, ly, lz) of space m, that of the segment ending at row j, and, with
+// `reactions`, the elastic part's reaction on the rigid segment (j - BS, j); in the
+// reference's order: vertex i, then j, then the segment's first node.
+void reference_spring(const Rows& r, const Space& m, int i, int j, const float* lx, const float* ly,
+                      const float* lz, const float* k, const Substep& s, bool reactions) {
+  const int oi = i * W, oj = j * W;
+  const float hgx = s.hg[0], hgy = s.hg[1], hgz = s.hg[2];
+  const float *lift = r.field(LIFT, i), *iwi = r.field(IW, i), *lever = r.field(LV, j);
+  float *aix = r.ax + oi, *aiy = r.ay + oi, *aiz = r.az + oi;
+  const float *pix = r.px + oi, *piy = r.py + oi, *piz = r.pz + oi;
+  const float *pjx = r.px + oj, *pjy = r.py + oj, *pjz = r.pz + oj;
+  alignas(64) float rx[W], ry[W], rz[W];  // R = -F, the elastic part's reaction
+  alignas(64) float fx[W], fy[W], fz[W];  // its share f_A on the segment's first node
   LANES {
     const float a = lx[l], b = ly[l], c = lz[l];
-    x[l] = (m.v[0][l] * a + (m.v[3][l] * b + m.v[6][l] * c) + ox[l]) - gx * lift[l];
-    y[l] = (m.v[1][l] * a + (m.v[4][l] * b + m.v[7][l] * c) + oy[l]) - gy * lift[l];
-    z[l] = (m.v[2][l] * a + (m.v[5][l] * b + m.v[8][l] * c) + oz[l]) - gz * lift[l];
+    const float dx = m.v[0][l] * a + (m.v[3][l] * b + m.v[6][l] * c);
+    const float dy = m.v[1][l] * a + (m.v[4][l] * b + m.v[7][l] * c);
+    const float dz = m.v[2][l] * a + (m.v[5][l] * b + m.v[8][l] * c);
+    const float kk = k[l];
+    const float ex = kk * (dx - (pix[l] - pjx[l]));
+    const float ey = kk * (dy - (piy[l] - pjy[l]));
+    const float ez = kk * (dz - (piz[l] - pjz[l]));
+    const float kl = kk * lift[l];
+    const bool free = iwi[l] != 0.0f;
+    aix[l] = free ? aix[l] + (ex - kl * hgx) : aix[l];
+    aiy[l] = free ? aiy[l] + (ey - kl * hgy) : aiy[l];
+    aiz[l] = free ? aiz[l] + (ez - kl * hgz) : aiz[l];
+    rx[l] = -ex;
+    ry[l] = -ey;
+    rz[l] = -ez;
+    const float dot = m.v[3][l] * rx[l] + (m.v[4][l] * ry[l] + m.v[5][l] * rz[l]);
+    fx[l] = (dot * dx - b * rx[l]) / lever[l];
+    fy[l] = (dot * dy - b * ry[l]) / lever[l];
+    fz[l] = (dot * dz - b * rz[l]) / lever[l];
+  }
+  if (!reactions || j == 0) return;  // space 0 is the head's
+  const float *bs = r.field(BS, j), *iwj = r.field(IW, j);
+  float *ajx = r.ax + oj, *ajy = r.ay + oj, *ajz = r.az + oj;
+  LANES {
+    const bool on = bs[l] != 0.0f && iwj[l] != 0.0f;
+    ajx[l] = on ? ajx[l] + (rx[l] - fx[l]) : ajx[l];
+    ajy[l] = on ? ajy[l] + (ry[l] - fy[l]) : ajy[l];
+    ajz[l] = on ? ajz[l] + (rz[l] - fz[l]) : ajz[l];
+  }
+  // The segment's first node: j-1, or further back where segment j is rounding-sized.
+  const float* iwa = r.field(IW, j - 1);
+  float *aax = ajx - W, *aay = ajy - W, *aaz = ajz - W;
+  alignas(64) int far[W];
+  LANES {
+    const bool on = bs[l] == 1.0f && iwa[l] != 0.0f;
+    aax[l] = on ? aax[l] + fx[l] : aax[l];
+    aay[l] = on ? aay[l] + fy[l] : aay[l];
+    aaz[l] = on ? aaz[l] + fz[l] : aaz[l];
+    far[l] = static_cast<int>(bs[l] > 1.0f);
+  }
+  if (!any_lane(far)) return;
+  for (int l = 0; l < W; ++l) {
+    if (!far[l]) continue;
+    const int o = (j - static_cast<int>(bs[l])) * W + l;
+    if (r.c[static_cast<std::size_t>(IW) * r.n * W + o] == 0.0f) continue;
+    r.ax[o] += fx[l];
+    r.ay[o] += fy[l];
+    r.az[o] += fz[l];
   }
 }
 
-// §4.3's first two steps (tangent_spaces, cascade_references): the tangent spaces from
-// the root up, each used at once for the upward reference node of the vertex above it
-// and the downward one of the vertex two below it.
-void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
+// Space j from its parent's, for every lane whose segment has its own direction
+// (tangent_spaces); narrow[l] marks the lanes whose B is undefined that way.
+template <bool kTransport>
+inline void own_space(const Space& parent, Space& cur, const float* ax, const float* ay, const float* az,
+                      const float* bx, const float* by, const float* bz, const float* bs, int* narrow) {
+  LANES {
+    const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
+    const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
+    const bool own = bs[l] == 1.0f && len > 0.0f;
+    const float nx = ex / len, ny = ey / len, nz = ez / len;
+    float b0, b1, b2;
+    bool ok;
+    if constexpr (kTransport) {
+      const float mx = parent.v[3][l], my = parent.v[4][l], mz = parent.v[5][l];
+      const float c = mx * nx + (my * ny + mz * nz);
+      ok = c > -0.999f;
+      const float qx = my * nz - mz * ny, qy = mz * nx - mx * nz, qz = mx * ny - my * nx;  // N_{j-1} × N
+      const float Bx = parent.v[0][l], By = parent.v[1][l], Bz = parent.v[2][l];
+      const float sc = (qx * Bx + (qy * By + qz * Bz)) / (1.0f + c);
+      b0 = (c * Bx + (qy * Bz - qz * By)) + sc * qx;
+      b1 = (c * By + (qz * Bx - qx * Bz)) + sc * qy;
+      b2 = (c * Bz + (qx * By - qy * Bx)) + sc * qz;
+      const float dn = b0 * nx + (b1 * ny + b2 * nz);
+      b0 = b0 - dn * nx;
+      b1 = b1 - dn * ny;
+      b2 = b2 - dn * nz;
+      const float bn2 = b0 * b0 + (b1 * b1 + b2 * b2);
+      const float bn = std::sqrt(bn2);
+      b0 = bn2 > 0.0f ? b0 / bn : b0;
+      b1 = bn2 > 0.0f ? b1 / bn : b1;
+      b2 = bn2 > 0.0f ? b2 / bn : b2;
+    } else {
+      const float Tx = parent.v[6][l], Ty = parent.v[7][l], Tz = parent.v[8][l];
+      b0 = ny * Tz - nz * Ty;
+      b1 = nz * Tx - nx * Tz;
+      b2 = nx * Ty - ny * Tx;
+      const float bl = std::sqrt(b0 * b0 + (b1 * b1 + b2 * b2));
+      ok = bl > 1e-6f;
+      b0 = b0 / bl;
+      b1 = b1 / bl;
+      b2 = b2 / bl;
+    }
+    narrow[l] = static_cast<int>(own) & static_cast<int>(!ok);
+    cur.v[0][l] = own ? b0 : parent.v[0][l];
+    cur.v[1][l] = own ? b1 : parent.v[1][l];
+    cur.v[2][l] = own ? b2 : parent.v[2][l];
+    cur.v[3][l] = own ? nx : parent.v[3][l];
+    cur.v[4][l] = own ? ny : parent.v[4][l];
+    cur.v[5][l] = own ? nz : parent.v[5][l];
+    cur.v[6][l] = own ? ny * b2 - nz * b1 : parent.v[6][l];
+    cur.v[7][l] = own ? nz * b0 - nx * b2 : parent.v[7][l];
+    cur.v[8][l] = own ? nx * b1 - ny * b0 : parent.v[8][l];
+  }
+}
+
+// §4.3's first two steps and the springs' forces (tangent_spaces, cascade_accelerations):
+// every acceleration starts from gravity; then the tangent spaces from the root up, each
+// used at once for the springs it carries, the upward one of the vertex above it and the
+// downward one of the vertex two below it.
+void cascade_forces(const Rows& r, const Substep& s, const BlockParams& p, const Frame& f) {
   const int n = r.n;
-  const float* rest_space = r.c + static_cast<std::size_t>(kCascadeFields) * n * W;
-  // The root segment's space, rigid with the head: head rotation · rest space.
-  // sp[0] the root's; then row i's parent is sp[i & 1] and its space goes to the other.
+  const float* root_space = r.c + static_cast<std::size_t>(kCascadeFields) * n * W;
+  const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
+  for (int i = 0; i < n * W; ++i) {
+    r.ax[i] = gx;
+    r.ay[i] = gy;
+    r.az[i] = gz;
+  }
+  // Space 0, the given one at the root: head rotation · its rest space. Then row j's
+  // parent is sp[(j - 1) & 1] and its space goes to sp[j & 1].
   Space sp[2];
   for (int col = 0; col < 3; ++col)
     for (int row = 0; row < 3; ++row) {
       const float h0 = s.m[3 * row], h1 = s.m[3 * row + 1], h2 = s.m[3 * row + 2];
-      const float *s0 = rest_space + (3 * col) * W, *s1 = s0 + W, *s2 = s1 + W;
+      const float *s0 = root_space + (3 * col) * W, *s1 = s0 + W, *s2 = s1 + W;
       float* out = sp[0].v[3 * col + row];
       LANES { out[l] = h0 * s0[l] + (h1 * s1[l] + h2 * s2[l]); }
     }
-  // Rows 0 and 1 have no upward reference node; their springs have k = 0 and pull
-  // towards the origin, as the reference's never-written entries.
-  for (int i = 0; i < 2 && i < n; ++i)
-    LANES {
-      r.ux[i * W + l] = 0.0f;
-      r.uy[i * W + l] = 0.0f;
-      r.uz[i * W + l] = 0.0f;
-    }
-  auto up = [&](const Space& m, int i) {  // vertex i in the space of segment i-1
-    const int o = i * W, p = o - W;
-    place(m, r.field(UX, i), r.field(UY, i), r.field(UZ, i), r.px + p, r.py + p, r.pz + p, r.field(LIFT, i), f,
-          r.ux + o, r.uy + o, r.uz + o);
+  auto up = [&](const Space& m, int j) {  // vertex j+1 in space j
+    reference_spring(r, m, j + 1, j, r.field(UX, j + 1), r.field(UY, j + 1), r.field(UZ, j + 1), r.field(KU, j + 1),
+                     s, p.reactions);
   };
-  auto down = [&](const Space& m, int i) {  // vertex i in the space of segment i+2
-    const int o = i * W, p = o + 2 * W;
-    place(m, r.field(DX, i), r.field(DY, i), r.field(DZ, i), r.px + p, r.py + p, r.pz + p, r.field(LIFT, i), f,
-          r.dx + o, r.dy + o, r.dz + o);
+  auto down = [&](const Space& m, int j) {  // vertex j-2 in space j
+    reference_spring(r, m, j - 2, j, r.field(DX, j - 2), r.field(DY, j - 2), r.field(DZ, j - 2), r.field(KD, j - 2),
+                     s, p.reactions);
   };
-  if (n > 2) up(sp[0], 2);
-  for (int i = 2; i < n; ++i) {
-    const Space& parent = sp[i & 1];
-    Space& cur = sp[(i + 1) & 1];
-    const int o = i * W;
+  if (n > 1) up(sp[0], 0);
+  for (int j = 1; j < n; ++j) {
+    const Space& parent = sp[(j - 1) & 1];
+    Space& cur = sp[j & 1];
+    const int o = j * W;
     const float *ax = r.px + o - W, *ay = r.py + o - W, *az = r.pz + o - W;
     const float *bx = r.px + o, *by = r.py + o, *bz = r.pz + o;
-    // B = N × T_{n-1} normalised; where N is (nearly) parallel to the parent's T, B_{n-1}
-    // made perpendicular to N instead. That case is rare: it is computed, for the lanes
-    // in it, only in rows that have one (two roots and three divisions saved per row).
+    const float* bs = r.field(BS, j);
+    // The segment's own B: B = N × T_{j-1} normalised (Cross) or the parent's B turned with
+    // the segment (Transport); where that is undefined, B_{j-1} made perpendicular to N
+    // instead. That case is rare: it is computed, for the lanes in it, only in rows that
+    // have one. A segment with a base further back (or of zero length) keeps its
+    // parent's space.
     alignas(64) int narrow[W];
-    LANES {
-      const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
-      const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
-      const bool ok = len > 0.0f;
-      const float nx = ex / len, ny = ey / len, nz = ez / len;
-      const float Tx = parent.v[6][l], Ty = parent.v[7][l], Tz = parent.v[8][l];
-      float b0 = ny * Tz - nz * Ty, b1 = nz * Tx - nx * Tz, b2 = nx * Ty - ny * Tx;
-      const float bl = std::sqrt(b0 * b0 + (b1 * b1 + b2 * b2));
-      b0 = b0 / bl;
-      b1 = b1 / bl;
-      b2 = b2 / bl;
-      narrow[l] = static_cast<int>(ok) & static_cast<int>(!(bl > 1e-6f));
-      cur.v[0][l] = ok ? b0 : parent.v[0][l];
-      cur.v[1][l] = ok ? b1 : parent.v[1][l];
-      cur.v[2][l] = ok ? b2 : parent.v[2][l];
-      cur.v[3][l] = ok ? nx : parent.v[3][l];
-      cur.v[4][l] = ok ? ny : parent.v[4][l];
-      cur.v[5][l] = ok ? nz : parent.v[5][l];
-      cur.v[6][l] = ok ? ny * b2 - nz * b1 : Tx;
-      cur.v[7][l] = ok ? nz * b0 - nx * b2 : Ty;
-      cur.v[8][l] = ok ? nx * b1 - ny * b0 : Tz;
-    }
+    if (p.transport)
+      own_space<true>(parent, cur, ax, ay, az, bx, by, bz, bs, narrow);
+    else
+      own_space<false>(parent, cur, ax, ay, az, bx, by, bz, bs, narrow);
     if (any_lane(narrow))
       LANES {
         const bool on = narrow[l] != 0;
@@ -408,8 +481,8 @@ void cascade_references(const Rows& r, const Substep& s, const Frame& f) {
         cur.v[7][l] = on ? nz * b0 - nx * b2 : cur.v[7][l];
         cur.v[8][l] = on ? nx * b1 - ny * b0 : cur.v[8][l];
       }
-    if (i + 1 < n) up(cur, i + 1);
-    down(cur, i - 2);
+    if (j + 1 < n) up(cur, j);
+    if (j >= 3) down(cur, j);
   }
 }
 
@@ -436,9 +509,6 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
          scratch,
          scratch + rows,
          scratch + 2 * rows,
-         scratch + 3 * rows,
-         scratch + 4 * rows,
-         scratch + 5 * rows,
          b.data,
          b.rows};
   soa::StageClock clock(stage_ns);
@@ -450,12 +520,22 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
     const soa::AffinePose h(s.m, s.t);
     if constexpr (kModel == Model::Cascade) {
       follow_head(r, h);
-      cascade_references(r, s, f);
+      cascade_forces(r, s, p, f);
       clock.lap(kReferences);  // the spring model's references are computed in its integration
       feed.step();
     }
-    const Integration in{h,      f.gravity[0], f.gravity[1], f.gravity[2], f.wind[0], f.wind[1], f.wind[2],
-                         p.keep, s.dt2,        kModel == Model::Spring ? p.spring_scale[k] : 1.0f};
+    // The cascade's gravity is in its accelerations (cascade_forces).
+    constexpr bool kSpring = kModel == Model::Spring;
+    const Integration in{h,
+                         kSpring ? f.gravity[0] : 0.0f,
+                         kSpring ? f.gravity[1] : 0.0f,
+                         kSpring ? f.gravity[2] : 0.0f,
+                         f.wind[0],
+                         f.wind[1],
+                         f.wind[2],
+                         p.keep,
+                         s.dt2,
+                         kSpring ? p.spring_scale[k] : 1.0f};
     if (f.windy)
       integrate<kModel, true>(r, in);
     else

@@ -20,32 +20,35 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   substeps_ = params.get_int("substeps");
   sleep_.reset(rest.strand_count());
 
+  frames_ = static_cast<k::CascadeFrames>(params.get_int("frames"));
+  reactions_ = params.get_int("reactions") != 0;
   const std::size_t nv = rest.vertex_count();
-  k_up_.resize(nv);
-  k_down_.resize(nv);
+  for (auto* v : {&inv_mass_, &k_up_, &k_down_, &lift_, &lever_}) v->resize(nv);
+  base_.resize(nv);
   rest_space_.resize(nv);
   up_local_.resize(nv);
   down_local_.resize(nv);
-  lift_.resize(nv);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
-    k::cascade_setup(std::span(rest.positions).subspan(b, n), static_cast<float>(params.get("stiffness", r)),
+    const std::size_t r = rest.strand_region[s];
+    k::cascade_setup(strand(rest_.positions, s), static_cast<float>(params.get("stiffness", r)),
                      static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
-                     static_cast<float>(params.get("down_fraction", r)), std::span(k_up_).subspan(b, n),
-                     std::span(k_down_).subspan(b, n), std::span(rest_space_).subspan(b, n),
-                     std::span(up_local_).subspan(b, n), std::span(down_local_).subspan(b, n),
-                     std::span(lift_).subspan(b, n));
+                     static_cast<float>(params.get("down_fraction", r)), frames_, strand(inv_mass_, s),
+                     strand(k_up_, s), strand(k_down_, s), strand(lift_, s), strand(base_, s), strand(lever_, s),
+                     strand(rest_space_, s), strand(up_local_, s), strand(down_local_, s));
   }
+  // The cascade's own inverse masses (vertex 1 free): follow_head moves the vertices its
+  // rest copy pins, the other kernels read the positions' w.
+  for (std::size_t i = 0; i < nv; ++i) rest_.positions[i].w() = pos_[i].w() = prev_[i].w() = inv_mass_[i];
   space_ = rest_space_;
-  up_ref_.assign(nv, Vec3f::Zero());
-  down_ref_.assign(nv, Vec3f::Zero());
+  acc_.assign(nv, Vec3f::Zero());
 }
 
 std::size_t CascadeModel::state_bytes() const {
   return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
-         (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size()) * sizeof(float) +
-         (rest_space_.size() + space_.size()) * sizeof(kernels::Mat3f) +
-         (up_local_.size() + down_local_.size() + up_ref_.size() + down_ref_.size()) * sizeof(Vec3f);
+         (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size() + inv_mass_.size() + lever_.size()) *
+             sizeof(float) +
+         base_.size() * sizeof(int) + (rest_space_.size() + space_.size()) * sizeof(kernels::Mat3f) +
+         (up_local_.size() + down_local_.size() + acc_.size()) * sizeof(Vec3f);
 }
 
 template <class T>
@@ -85,25 +88,25 @@ void CascadeModel::step(const FrameInput& in, StageTimes& times) {
 void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
   const FramePlan plan = plan_frame(in, ctx_);
   const k::Mat3f head_rotation = head.linear();
+  const Vec3f head_gravity = head_rotation * in.gravity;
   {
     StageTimer t(times, "references");
     for_each_strand([&](std::size_t s, const RegionSettings&) {
       const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
       k::follow_head(strand(pos_, s), strand(prev_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n), head);
-      k::tangent_spaces(strand(pos_, s), head_rotation * rest_space_[b + 1], strand(space_, s));
-      k::cascade_references(strand(pos_, s), strand(space_, s), strand(up_local_, s), strand(down_local_, s),
-                            strand(lift_, s), in.gravity, strand(up_ref_, s), strand(down_ref_, s));
+      k::tangent_spaces(strand(pos_, s), head_rotation * rest_space_[b], frames_, strand(base_, s), strand(space_, s));
+      const k::CascadeStrand cs{strand(inv_mass_, s), strand(k_up_, s),   strand(k_down_, s),   strand(lift_, s),
+                                strand(base_, s),     strand(lever_, s),  strand(up_local_, s), strand(down_local_, s)};
+      k::cascade_accelerations(strand(pos_, s), strand(space_, s), cs, reactions_, in.gravity, head_gravity,
+                               strand(acc_, s));
     });
   }
   {
     StageTimer t(times, "integrate");
     for_each_strand([&](std::size_t s, const RegionSettings& r) {
-      const std::size_t n = rest_.strand_size(s);
-      k::verlet_integrate(strand(pos_, s), strand(prev_, s), in.gravity, in.wind, plan.wind, r.damping, dt);
-      k::add_spring_acceleration(strand(pos_, s), strand(prev_, s), strand(up_ref_, s), strand(k_up_, s), 1.0f, dt);
-      if (n > 2)
-        k::add_spring_acceleration(strand(pos_, s).first(n - 2), strand(prev_, s).first(n - 2),
-                                   strand(down_ref_, s).first(n - 2), strand(k_down_, s).first(n - 2), 1.0f, dt);
+      // Gravity is in the accelerations (cascade_accelerations).
+      k::verlet_integrate(strand(pos_, s), strand(prev_, s), Vec3f::Zero(), in.wind, plan.wind, r.damping, dt);
+      k::add_acceleration(strand(pos_, s), strand(acc_, s), dt);
     });
   }
   {

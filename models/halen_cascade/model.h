@@ -2,9 +2,13 @@
 // step carry two reference nodes per free strand node, an upward one in the space of
 // the segment above it and a downward one in the space of the segment two below it;
 // zero-rest-length springs F = kL pull the node to both (Verlet, Eq. 4.1), then edge
-// corrections (Eq. 4.2). The reference nodes are displaced upward to cancel gravity on
-// the rest shape, spring strength falls with the distance from the root and the downward springs
-// are a fraction of the upward ones (§5.9).
+// corrections (Eq. 4.2). Only node 0 is fixed; node 1's upward reference node is in the
+// given space at the root. Each spring is half of the torsion spring the reference nodes
+// simulate: its elastic part pushes back on the segment that carries its space
+// (kernels::cascade_accelerations). The reference nodes are displaced upward, rigidly
+// with the head, to carry the nodes' weight at rest; spring strength falls with the
+// distance from the root and the downward springs are a fraction of the upward ones
+// (§5.9).
 #pragma once
 
 #include "core/hair_model.h"
@@ -43,7 +47,12 @@ class CascadeModel final : public HairModel {
   std::vector<kernels::Mat3f> rest_space_, space_;  // [B N T] per segment (by end vertex)
   std::vector<Vec3f> up_local_, down_local_;        // reference nodes in their spaces
   std::vector<float> lift_;                         // upward displacement per unit gravity
-  std::vector<Vec3f> up_ref_, down_ref_;            // ... in world space, this substep
+  std::vector<float> inv_mass_;                     // the groom's, vertex 1 freed
+  std::vector<int> base_;                           // rigid segment carrying each space
+  std::vector<float> lever_;                        // ... and its rest length
+  std::vector<Vec3f> acc_;                          // the springs' accelerations, this substep
+  kernels::CascadeFrames frames_ = kernels::CascadeFrames::Transport;
+  bool reactions_ = true;
   std::vector<RegionSettings> region_;
   int substeps_ = 1;
   StrandSleep sleep_;

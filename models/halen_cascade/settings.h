@@ -2,13 +2,18 @@
 // and weakened downward springs).
 //
 // Stiffnesses are per unit node mass (s^-2), so the node mass m of L = mg/k cancels.
+// Each reference spring, with its reaction on the segment that carries its space, is half
+// of a torsion spring: the springs make no energy (to the twist the reaction leaves out,
+// below), and the rest state is stable at any strand length. They make a strand an elastic rod whose slowest mode, the strand turning
+// about its root, has a stiffness of about k (ℓ/L)^4 for segments ℓ of a strand L: quick
+// at the thesis's 4 and 8 nodes, slow at 16 (docs/limitations.md, "The cascade").
 // Defaults are chosen for real gravity, 25 cm strands of 16 vertices and 60 Hz frames:
-// k = 1500 s^-2 at the root falling quadratically past 20 cm, downward springs at a
-// quarter of the upward ones (§5.9), six substeps with six edge corrections. Each
-// node's upward reference extrapolates the segment above it, so a disturbance is passed
-// down the strand with a gain of up to 3 per node (2 u_{i-1} - u_{i-2}); on 16-node
-// strands only strong damping (0.1 per substep, about 36/s) keeps that in check, and
-// the strand still returns to its rest shape slowly (seconds, not frames).
+// k = 6000 s^-2 at the root falling quadratically past 20 cm, as stiff as explicit Verlet
+// at six substeps allows with a margin (the probe finds the rest state growing at
+// 30,000); downward springs at a quarter of the upward ones (§5.9); six edge
+// corrections; damping 0.1 per substep, which keeps the slow mode from swinging for
+// seconds after the head stops, and damps what the reaction leaves out (that a space's
+// twist also follows the segments above it): at 0.03 some crown strands start to swing.
 #pragma once
 
 #include "core/params.h"
@@ -17,10 +22,10 @@
 
 namespace hairbench::halen_cascade {
 
-inline constexpr std::array<ParamSpec, 7> kParams{{
+inline constexpr std::array<ParamSpec, 9> kParams{{
     {"damping", 0.1, 0.0, 1.0, false,
      "fraction of velocity removed per substep in Verlet (Eq. 4.1: k = 1 - damping)"},
-    {"stiffness", 1500.0, 0.0, 1e6, false,
+    {"stiffness", 6000.0, 0.0, 1e6, false,
      "k: upward reference spring strength at the root per unit node mass, s^-2 (§4.3, §5.9)"},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
     {"falloff_scale", 5.0, 0.0, 1e4, false,
@@ -29,6 +34,12 @@ inline constexpr std::array<ParamSpec, 7> kParams{{
      "downward reference springs' strength as a fraction of the upward ones (§5.9; 1 = equal)"},
     {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep"},
     {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
+    {"reactions", 1, 0, 1, true,
+     "1: each reference spring pushes back on the segment that carries its space (the torsion spring "
+     "§4.3 says the reference nodes simulate); 0: the reference nodes are fixed during the step"},
+    {"frames", 1, 0, 1, true,
+     "how a tangent space takes B and T from its parent's: 0 the thesis's B = N x T_parent (§4.3), "
+     "1 parallel transport (the parent's space turned with the segment)"},
 }};
 
 }  // namespace hairbench::halen_cascade

@@ -14,6 +14,9 @@ void ForestModel::reset(const Groom& rest, const ParamSet& params) {
   rest_ = rest;
   axes_ = params.get_int("axis_convention") == 0 ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
   substeps_ = params.get_int("substeps");
+  inertia_ = params.get_int("inertia") == 0 ? k::ForestInertia::Mass : k::ForestInertia::StrandPendulum;
+  gravity_compensation_ = params.get_int("gravity_compensation") != 0;
+  root_angular_acceleration_ = params.get_int("root_angular_acceleration") != 0;
   joint_damping_.clear();
   collision_stiffness_.clear();
   for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
@@ -107,6 +110,10 @@ void ForestModel::step(const FrameInput& in, StageTimes& times) {
     f.wind = in.wind;
     f.head_rotation = head.linear();
     f.inertia = k::root_inertia(head, head_hist_[1], head_hist_[0], dt);
+    f.inertia_model = inertia_;
+    f.gravity_compensation = gravity_compensation_;
+    if (root_angular_acceleration_)
+      f.root_angular_acceleration = k::head_angular_acceleration(head, head_hist_[1], head_hist_[0], dt);
     head_hist_[0] = head_hist_[1];
     head_hist_[1] = head;
     spheres_.clear();

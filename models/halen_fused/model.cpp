@@ -135,11 +135,19 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
   const std::size_t nv = rest.vertex_count();
   const bool spring = model_ == Model::Spring, forest = model_ == Model::Forest;
   const std::vector<float> rest_length = rest_edge_lengths(rest);
-  std::vector<float> k_up(nv), k_down(nv), lift(nv), theta0(nv), phi0(nv), length(nv);
+  std::vector<float> k_up(nv), k_down(nv), lift(nv), theta0(nv), phi0(nv), length(nv), inv_mass(nv), lever(nv);
+  std::vector<int> base(nv);
   std::vector<k::Mat3f> space(spring ? 0 : nv);  // cascade: rest tangent spaces; forest: rest frames
   std::vector<Vec3f> up_local(spring ? 0 : nv), down_local(spring ? 0 : nv);
   const auto axes = forest && params.get_int("axis_convention") == 0 ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
   forest_frame_.parent_x = axes == k::ForestAxes::ParentX;
+  forest_frame_.mass_inertia = forest && params.get_int("inertia") == 0;
+  forest_frame_.gravity_compensation = forest && params.get_int("gravity_compensation") != 0;
+  forest_root_angular_ = forest && params.get_int("root_angular_acceleration") != 0;
+  if (!spring && !forest) {
+    cascade_frames_ = static_cast<k::CascadeFrames>(params.get_int("frames"));
+    cascade_reactions_ = params.get_int("reactions") != 0;
+  }
   inv_length_.assign(rest.strand_count(), 0.0f);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
     const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
@@ -151,12 +159,21 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
       k::spring_setup(strand_rest, static_cast<float>(params.get("stiffness", r)), c, a, at(k_up), at(lift));
     else if (!forest)
       k::cascade_setup(strand_rest, static_cast<float>(params.get("stiffness", r)), c, a,
-                       static_cast<float>(params.get("down_fraction", r)), at(k_up), at(k_down), at(space),
-                       at(up_local), at(down_local), at(lift));
+                       static_cast<float>(params.get("down_fraction", r)), cascade_frames_, at(inv_mass), at(k_up),
+                       at(k_down), at(lift), at(base), at(lever), at(space), at(up_local), at(down_local));
     else
       inv_length_[s] = k::forest_setup(strand_rest, axes, static_cast<float>(params.get("joint_stiffness", r)), c, a,
                                        at(space), at(theta0), at(phi0), at(length), at(k_up));
   }
+  const bool cascade = !spring && !forest;
+  if (cascade)  // the cascade's own inverse masses (vertex 1 free) decide its rows' kinds
+    for (const BlockInfo& b : blocks_)
+      for (int v = 0; v < b.n; ++v) {
+        int pinned = 0;
+        for (int l = 0; l < W; ++l) pinned += inv_mass[b.offset_of[l] + static_cast<std::size_t>(v)] == 0.0f;
+        row_kinds_[b.rows + static_cast<std::size_t>(v)] =
+            pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed;
+      }
   for (const BlockInfo& b : blocks_) {
     float* d = data_.data() + b.offset;
     float* st = state_.data() + b.state;
@@ -189,7 +206,7 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
         row(d, soa::RX, i, l) = p0.x();
         row(d, soa::RY, i, l) = p0.y();
         row(d, soa::RZ, i, l) = p0.z();
-        row(d, soa::IW, i, l) = p0.w();
+        row(d, soa::IW, i, l) = cascade ? inv_mass[v] : p0.w();
         row(d, soa::RL, i, l) = rest_length[v];
         row(d, soa::LIFT, i, l) = lift[v];
         row(d, soa::KU, i, l) = k_up[v];
@@ -199,7 +216,9 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
           row(d, soa::UX + c, i, l) = up_local[v][c];
           row(d, soa::DX + c, i, l) = down_local[v][c];
         }
-        if (i == 1) {  // the root segment's rest space, column by column
+        row(d, soa::BS, i, l) = base[v] < 0 ? 0.0f : static_cast<float>(i - base[v]);
+        row(d, soa::LV, i, l) = lever[v];
+        if (i == 0) {  // the given space at the root, column by column
           float* root = d + static_cast<std::size_t>(soa::kCascadeFields) * rows;
           for (int c = 0; c < 3; ++c)
             for (int e = 0; e < 3; ++e) root[(3 * c + e) * W + l] = space[v](e, c);
@@ -250,7 +269,8 @@ void HalenFusedModel::run_thread(int t) {
     if (asleep > 0) std::copy_n(state, floats, backup);
     const Region& r = region_[b.region];
     const soa::BlockParams p{r.keep, r.length_iterations,
-                             spring_scale_.data() + static_cast<std::size_t>(b.region) * substep_.size()};
+                             spring_scale_.data() + static_cast<std::size_t>(b.region) * substep_.size(),
+                             cascade_reactions_, cascade_frames_ == k::CascadeFrames::Transport};
     const soa::Block block{data_.data() + b.offset, state, b.n, b.offset_of.data(), row_kinds_.data() + b.rows, write};
     std::int64_t* stage_ns = b.sampled ? ts.stage_ns.data() : nullptr;
     const auto start = std::chrono::steady_clock::now();
@@ -319,10 +339,13 @@ void HalenFusedModel::forest_substeps(const FrameInput& in, float dt) {
     }
     if (last) break;
     const k::Mat34f inertia = k::root_inertia(head, head_hist_[1], head_hist_[0], dt);
+    const Vec3f angular =
+        forest_root_angular_ ? k::head_angular_acceleration(head, head_hist_[1], head_hist_[0], dt) : Vec3f::Zero();
     head_hist_[0] = head_hist_[1];
     head_hist_[1] = head;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) s.inertia[4 * r + c] = inertia(r, c);
+    for (int r = 0; r < 3; ++r) s.root_angular[r] = angular[r];
     float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
     write_spheres(in.colliders.first(nc), head, sp);
     s.spheres = sp;
@@ -361,6 +384,11 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
       s.t[r] = head.translation()[r];
     }
     s.dt2 = dt * dt;
+    if (model_ == Model::Cascade) {  // as halen_cascade_ref's substep
+      const k::Mat3f head_rotation = head.linear();
+      const Vec3f head_gravity = head_rotation * in.gravity;
+      for (int c = 0; c < 3; ++c) s.hg[c] = head_gravity[c];
+    }
     float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
     write_spheres(in.colliders.first(nc), head, sp);
     s.spheres = sp;

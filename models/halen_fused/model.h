@@ -9,6 +9,7 @@
 
 #include "core/hair_model.h"
 #include "core/sleep.h"
+#include "kernels/cpu/halen_kernels.h"
 #include "kernels/cpu/halen_soa.h"
 #include "models/block_threads.h"
 
@@ -86,8 +87,11 @@ class HalenFusedModel final : public HairModel {
   // The forest's substeps (and the final head pose), frame, axes and root motion history.
   std::vector<kernels::halen_soa::ForestSubstep> forest_substep_;
   kernels::halen_soa::ForestFrame forest_frame_{};
+  bool forest_root_angular_ = false;  // the forest's root_angular_acceleration parameter
   Affine3f head_hist_[2];
   std::vector<float> inv_length_;  // forest: 1/ℓ per strand
+  kernels::CascadeFrames cascade_frames_ = kernels::CascadeFrames::Transport;  // cascade: "frames"
+  bool cascade_reactions_ = true;                                              // cascade: "reactions"
   bool calm_ = false;
   StrandSleep sleep_;
   std::vector<std::uint32_t> strand_begin_;
