@@ -3,6 +3,7 @@
 
 #include "core/groom.h"
 #include "core/params.h"
+#include "core/stage.h"
 #include "core/types.h"
 
 #include <array>
@@ -16,48 +17,48 @@ namespace hairbench {
 
 class ThreadPool;
 
-// Wall time per named solver stage within one step. Fixed capacity and no allocation:
-// it is filled inside the timed step.
+// Wall time per solver stage within one step, in the order the stages were first timed.
+// Fixed capacity and no allocation: it is filled inside the timed step.
 //
 // A stage the scene does not need is not run and is reported through skip(), so the
 // report shows it as 0 ms and skipped rather than leaving it out. A stage that ran in
 // any substep of the step counts as run.
 class StageTimes {
  public:
-  static constexpr std::size_t kMaxStages = 12;
   struct Entry {
-    std::string_view name;
+    Stage stage{};
+    std::string_view name;  // stage_name(stage)
     double ms = 0.0;
     bool skipped = false;
   };
-  void add(std::string_view name, double ms) {
-    if (Entry* e = find(name)) {
+  void add(Stage stage, double ms) {
+    if (Entry* e = find(stage)) {
       e->ms += ms;
       e->skipped = false;
       return;
     }
-    if (count_ < kMaxStages) entries_[count_++] = {name, ms, false};
+    entries_[count_++] = {stage, stage_name(stage), ms, false};
   }
-  void skip(std::string_view name) {
-    if (find(name) == nullptr && count_ < kMaxStages) entries_[count_++] = {name, 0.0, true};
+  void skip(Stage stage) {
+    if (find(stage) == nullptr) entries_[count_++] = {stage, stage_name(stage), 0.0, true};
   }
   void clear() { count_ = 0; }
   std::span<const Entry> entries() const { return {entries_.data(), count_}; }
 
  private:
-  Entry* find(std::string_view name) {
+  Entry* find(Stage stage) {
     for (std::size_t i = 0; i < count_; ++i)
-      if (entries_[i].name == name) return &entries_[i];
+      if (entries_[i].stage == stage) return &entries_[i];
     return nullptr;
   }
-  std::array<Entry, kMaxStages> entries_{};
+  std::array<Entry, kStageCount> entries_{};  // each stage at most once
   std::size_t count_ = 0;
 };
 
 // Times the scope it lives in and adds it to a stage.
 class StageTimer {
  public:
-  StageTimer(StageTimes& times, std::string_view stage)
+  StageTimer(StageTimes& times, Stage stage)
       : times_(times), stage_(stage), start_(std::chrono::steady_clock::now()) {}
   ~StageTimer() {
     const auto end = std::chrono::steady_clock::now();
@@ -68,7 +69,7 @@ class StageTimer {
 
  private:
   StageTimes& times_;
-  std::string_view stage_;
+  Stage stage_;
   std::chrono::steady_clock::time_point start_;
 };
 

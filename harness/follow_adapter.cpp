@@ -21,7 +21,7 @@ void FollowHairsAdapter::reset(const Groom& rest, const ParamSet& params) {
 
 void FollowHairsAdapter::step(const FrameInput& in, StageTimes& out_times) {
   inner_->step(in, out_times);
-  const StageTimer timer(out_times, "follow_hairs");
+  const StageTimer timer(out_times, Stage::FollowHairs);
   rebuild();
 }
 

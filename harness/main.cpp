@@ -170,16 +170,15 @@ void prepare_compare(CompareArgs& a, bool sweep) {
 #ifdef HAIRBENCH_HAS_VULKAN
     // On a CPU Vulkan device (lavapipe) the GPU models take seconds per frame: run them
     // only when --models asks for them.
-    if (why.empty() && m.unavailable && !a.models_given &&
+    if (why.empty() && m.platform == Platform::Vulkan && !a.models_given &&
         vk::Context::get(a.run.device)->device().type == "CPU")
       why = "the Vulkan device is a CPU (" + vk::Context::get(a.run.device)->device().name +
             "); name it in --models to run it";
 #endif
-    // The _ref variants are the straightforward implementations the fast models are
-    // measured against; their results are bit-identical to the fast models'.
-    if (why.empty() && !a.models_given && std::string_view(m.name).ends_with("_ref"))
-      why = "bit-identical reference implementation of " + std::string(m.name.substr(0, m.name.size() - 4)) +
-            "; name it in --models to run it";
+    // A reference implementation gives its fast model's bits, slower.
+    if (why.empty() && !a.models_given && !m.reference_of.empty())
+      why = std::string(m.reference_tolerance == 0.0 ? "bit-identical" : "rounding-level") +
+            " reference implementation of " + std::string(m.reference_of) + "; name it in --models to run it";
     if (why.empty()) a.run.models.emplace_back(m.name);
     else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
     else a.skipped.push_back(std::string(m.name) + ": " + why);
@@ -326,7 +325,7 @@ int cmd_stress(StressArgs& a) {
     throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
   }
   for (const ModelInfo& m : model_registry())
-    if (!m.unavailable && std::regex_match(std::string(m.name), re)) a.opt.models.emplace_back(m.name);
+    if (m.platform == Platform::Cpu && std::regex_match(std::string(m.name), re)) a.opt.models.emplace_back(m.name);
   if (a.opt.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no CPU model");
   ThreadPool pool(a.threads);
   const bool tty = isatty(fileno(stderr));

@@ -2,8 +2,8 @@
 
 #include "core/parallel.h"
 #include "harness/runner.h"
-#include "models/plante_wisp/model.h"
-#include "models/plante_wisp/settings.h"
+#include "models/plante2001/model.h"
+#include "models/plante2001/settings.h"
 #include "scenarios/groom_gen.h"
 
 #include <chrono>

@@ -6,19 +6,17 @@
 
 #include "core/hair_model.h"
 #include "core/parallel.h"
-#include "kernels/cpu/soa_common.h"
+#include "kernels/simd/soa_common.h"
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <string_view>
 #include <vector>
 
 namespace hairbench {
 
-template <std::size_t kStages>
 struct alignas(64) BlockThread {
-  std::array<std::int64_t, kStages> stage_ns{};
+  std::array<std::int64_t, kStageCount> stage_ns{};  // by stage_index
   std::int64_t sampled_ns = 0;
   std::size_t first = 0, last = 0;  // the thread's blocks (or jobs) [first, last)
 };
@@ -34,38 +32,35 @@ void for_each_block_thread(ThreadPool* pool, std::size_t threads, const F& run) 
     run(0);
 }
 
-template <std::size_t kStages>
-void clear_stage_clocks(std::vector<BlockThread<kStages>>& threads) {
-  for (BlockThread<kStages>& t : threads) {
+inline void clear_stage_clocks(std::vector<BlockThread>& threads) {
+  for (BlockThread& t : threads) {
     t.stage_ns.fill(0);
     t.sampled_ns = 0;
   }
 }
 
 // The step's stage times from its threads' sampled clocks and its wall time.
-template <std::size_t kStages>
 class SampledStageTimes {
  public:
-  SampledStageTimes(const std::vector<BlockThread<kStages>>& threads, double wall_ms) : wall_ms_(wall_ms) {
-    for (const BlockThread<kStages>& t : threads) {
-      for (std::size_t s = 0; s < kStages; ++s) ns_[s] += t.stage_ns[s];
+  SampledStageTimes(const std::vector<BlockThread>& threads, double wall_ms) : wall_ms_(wall_ms) {
+    for (const BlockThread& t : threads) {
+      for (std::size_t s = 0; s < kStageCount; ++s) ns_[s] += t.stage_ns[s];
       sampled_ += t.sampled_ns;
     }
   }
-  // Adds stage `stage` to `times` as `name`, or marks it skipped when it did not run.
-  void report(StageTimes& times, std::string_view name, int stage, bool ran) const {
+  // Adds `stage` to `times`, or marks it skipped when it did not run.
+  void report(StageTimes& times, Stage stage, bool ran) const {
     if (!ran) {
-      times.skip(name);
+      times.skip(stage);
       return;
     }
-    const double share = sampled_ > 0 ? static_cast<double>(ns_[static_cast<std::size_t>(stage)]) /
-                                            static_cast<double>(sampled_)
-                                      : 0.0;
-    times.add(name, wall_ms_ * share);
+    const double share =
+        sampled_ > 0 ? static_cast<double>(ns_[stage_index(stage)]) / static_cast<double>(sampled_) : 0.0;
+    times.add(stage, wall_ms_ * share);
   }
 
  private:
-  std::array<std::int64_t, kStages> ns_{};
+  std::array<std::int64_t, kStageCount> ns_{};
   std::int64_t sampled_ = 0;
   double wall_ms_;
 };

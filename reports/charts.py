@@ -57,7 +57,9 @@ except ImportError as e:  # the CLI turns exit 3 into "install python3-matplotli
 # Runs whose verdict is not ok, on the time-vs-error chart (docs/verdicts.md).
 STATUS_MARKERS = {"stretched": "s", "unstable": "X"}
 PHASE_COLOURS = {"move": "tab:blue", "oscillate": "tab:orange", "wind": "tab:green"}
-STAGE_ORDER = ["integrate", "global_shape", "local_shape", "length", "collision"]
+# Stages in the order a step runs them: the order of core/stage.h's name table.
+STAGE_ORDER = ["upload", "dispatch", "references", "pose", "integrate", "global_shape", "local_shape", "length",
+               "collision", "body_collision", "self_interaction", "rebuild", "follow_hairs", "sleep"]
 SCHEMA_VERSIONS = (1, 2)
 # Distinct stage colours: tab20's saturated then light halves, its greys left out (grey
 # is "untimed").

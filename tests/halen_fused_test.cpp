@@ -1,16 +1,13 @@
-// The fused structure-of-arrays Halén & Wester models (models/halen_fused) against the
-// per-stage reference implementations (halen_*_ref). The spring and cascade kernels
-// perform every strand's floating-point operations in the reference's order, so their
-// states must agree bit for bit, frame after frame, on equal and ragged grooms, with and
-// without wind and colliders, through sleep and wake. The forest kernel reorders the
-// joint rotations and computes sin/cos by polynomial, so it must agree to rounding. No
-// state may depend on the thread count or on the ISA variant of the kernel.
+// The fused Halén & Wester models (models/halen2007/fused/) beyond the scene matrix of
+// fused_reference_test.cpp: the cascade's and the forest's options, rounding-sized
+// edges, the forest's polynomial sin/cos, a state that depends on neither the thread
+// count nor the ISA variant of the kernel, and the stages reported.
 #include "agreement_support.h"
 
 #include "core/parallel.h"
-#include "kernels/cpu/halen_soa.h"
-#include "kernels/cpu/vec_math.h"
-#include "models/halen_fused/model.h"
+#include "kernels/halen2007/fused/halen_soa.h"
+#include "kernels/simd/vec_math.h"
+#include "models/halen2007/fused/model.h"
 #include "models/registry.h"
 #include "reports/metrics.h"
 
@@ -30,50 +27,7 @@ using test::state_hash_after;
 const std::vector<std::string> kExact = {"halen_spring", "halen_cascade"};
 const std::vector<std::string> kFused = {"halen_spring", "halen_cascade", "halen_forest"};
 
-TEST(HalenFused, BitIdenticalToReferenceOnShake) {
-  const Scenario sc = test::builtin("shake", 8);
-  for (const std::string& m : kExact) {
-    double diff = 0.0;
-    EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}, &diff), -1) << m << " max diff " << diff;
-  }
-}
-
-TEST(HalenFused, BitIdenticalToReferenceInWind) {
-  const Scenario sc = test::builtin("wind_gust", 16);
-  for (const std::string& m : kExact) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
-}
-
-// §4.4's tilt weakening changes the spring scale every substep.
-TEST(HalenFused, BitIdenticalToReferenceUpsideDown) {
-  const Scenario sc = test::builtin("tilt_upside_down", 16);
-  for (const std::string& m : kExact) EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}), -1) << m;
-}
-
-// The Table 1 model-1 groom: three regions, ragged vertex counts (partly filled blocks),
-// three colliders.
-TEST(HalenFused, BitIdenticalToReferenceOnRaggedPaperGroom) {
-  const Scenario sc = paper_model1(16);
-  std::set<std::uint32_t> sizes;
-  for (std::size_t s = 0; s < sc.groom.strand_count(); ++s) sizes.insert(sc.groom.strand_size(s));
-  ASSERT_GT(sizes.size(), 1u) << "the groom should be ragged";
-  for (const std::string& m : kExact) EXPECT_EQ(first_difference(sc, m, m + "_ref", 60, {}), -1) << m;
-}
-
-// Sleeping strands: the same strands fall asleep at the same frame, hold still
-// and wake when the head turns, in both implementations.
-TEST(HalenFused, BitIdenticalToReferenceThroughSleepAndWake) {
-  const Scenario sc = test::idle_then_turn();
-  for (const std::string& m : kExact) EXPECT_EQ(first_difference(sc, m, m + "_ref", sc.frames, {}), -1) << m;
-}
-
-// --no-skip (ModelContext::skip_inert off): every stage and term runs, nothing sleeps.
-TEST(HalenFused, BitIdenticalToReferenceWithoutSkipping) {
-  const Scenario sc = test::builtin("idle", 16);
-  for (const std::string& m : kExact)
-    EXPECT_EQ(first_difference(sc, m, m + "_ref", 120, {}, nullptr, false), -1) << m;
-}
-
-// The cascade's other choices (models/halen_cascade/settings.h): the thesis's fixed
+// The cascade's other choices (models/halen2007/cascade_settings.h): the thesis's fixed
 // reference nodes (reactions 0) and its B = N × T_parent spaces (frames 0); and a groom
 // with rounding-sized rest edges, whose segments take their parent's space and join its
 // rigid segment (kernels::cascade_setup), in some lanes of a block and not in others.
@@ -90,53 +44,7 @@ TEST(HalenFused, CascadeBitIdenticalForEveryChoiceAndRoundingSizedEdges) {
   EXPECT_EQ(first_difference(tiny, "halen_cascade", "halen_cascade_ref", 90, {}), -1);
 }
 
-// The forest against its reference on `shake` (a head shaken ±60° at 2 Hz for 2 s, then
-// held: 240 frames, colliders, gravity), frame after frame: the RMS vertex distance (the
-// report's deviation) stays within 1e-5 of the mean strand length. Measured: at most
-// 2.5e-6 L-bar RMS; single vertices differ by up to 7e-5 L-bar while the head shakes
-// (libm's sin/cos instead of the polynomial give 7e-6 RMS: the differences are the
-// reordered rounding amplified by the shaking, not the polynomial).
-TEST(HalenFused, ForestAgreesWithReferenceOnShake) {
-  const Scenario sc = test::builtin("shake", 8);
-  ThreadPool pool(2);
-  auto fast = test::make_named("halen_forest", sc, {}, pool);
-  auto ref = test::make_named("halen_forest_ref", sc, {}, pool);
-  const metrics::RestInfo rest(sc.groom);
-  double worst = 0.0;
-  for (int f = 0; f < sc.frames; ++f) {
-    StageTimes t;
-    fast->step(frame_input(sc, f), t);
-    ref->step(frame_input(sc, f), t);
-    worst = std::max(worst, metrics::deviation(fast->positions(), ref->positions(), rest.mean_strand_length));
-  }
-  RecordProperty("max_rms_deviation", std::to_string(worst));
-  EXPECT_LT(worst, 1e-5);
-  EXPECT_GT(worst, 0.0) << "the forest kernel reorders rounding; identical bits would mean the reference ran";
-}
-
-// Wind, and the paper's ragged groom with three colliders: the same bound. The paper
-// scenario's two substeps (Han & Harada's setting) are far below the forest's explicit
-// Euler limit (settings.h: twelve), where the reference's trajectory diverges from any
-// rounding change within a few frames; it runs here with the forest's own twelve.
-TEST(HalenFused, ForestAgreesWithReferenceInWindAndOnPaperGroom) {
-  const std::vector<ParamOverride> own_substeps = {{"*", "substeps", 12}};
-  for (const Scenario& sc : {test::builtin("wind_gust", 16), paper_model1(16)}) {
-    ThreadPool pool(2);
-    auto fast = test::make_named("halen_forest", sc, own_substeps, pool);
-    auto ref = test::make_named("halen_forest_ref", sc, own_substeps, pool);
-    const metrics::RestInfo rest(sc.groom);
-    double worst = 0.0;
-    for (int f = 0; f < 120; ++f) {
-      StageTimes t;
-      fast->step(frame_input(sc, f), t);
-      ref->step(frame_input(sc, f), t);
-      worst = std::max(worst, metrics::deviation(fast->positions(), ref->positions(), rest.mean_strand_length));
-    }
-    EXPECT_LT(worst, 1e-5) << sc.name;
-  }
-}
-
-// The forest's options that are not §4.2's (models/halen_forest/settings.h) through the
+// The forest's options that are not §4.2's (models/halen2007/forest_settings.h) through the
 // fast kernel: the thesis-as-written set and each option alone, on `shake`, the same
 // bound as the defaults. Known difference: with root_angular_acceleration alone the head's
 // angular acceleration counts twice and the hair never settles; in that motion the

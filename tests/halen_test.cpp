@@ -3,7 +3,7 @@
 #include "test_support.h"
 
 #include "harness/probe.h"
-#include "kernels/cpu/halen_kernels.h"
+#include "kernels/halen2007/reference/halen_kernels.h"
 #include "models/registry.h"
 #include "reports/metrics.h"
 #include "scenarios/groom_gen.h"

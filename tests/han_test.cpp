@@ -51,7 +51,7 @@ TEST(HanMethods, ReturnToRestShapeAfterRigidJump) {
 // §3.3: with global and local constraints "there is no visual perturbation when
 // simulation starts". Paper-like parameters (TressFX ponytail sample values), gravity
 // on, head still: method 1 stays within 2% of L-bar of the rest shape for a second.
-// "Paper-like" here is the default setting (models/han/settings.h explains why the
+// "Paper-like" here is the default setting (models/han2012/settings.h explains why the
 // TressFX values cannot hold a strand under metric gravity).
 TEST(HanMethods, QuietStart) {
   Scenario sc = builtin("idle");

@@ -1,10 +1,11 @@
 // Properties Plante, Cani & Poulin 2001 claims for the layered wisp model (§3-§5),
 // checked on hand-built wisp pairs and on the built-in scenarios.
-#include "kernels/cpu/vec_math.h"
-#include "kernels/cpu/wisp_grid.h"
-#include "kernels/cpu/wisp_soa.h"
-#include "models/plante_wisp/model.h"
-#include "models/plante_wisp/settings.h"
+#include "kernels/simd/isa.h"
+#include "kernels/simd/vec_math.h"
+#include "kernels/plante2001/wisp_grid.h"
+#include "kernels/plante2001/fused/wisp_soa.h"
+#include "models/plante2001/model.h"
+#include "models/plante2001/settings.h"
 #include "reports/metrics.h"
 #include "reports/verdict.h"
 #include "test_support.h"
@@ -689,7 +690,7 @@ TEST(PlanteWisp, IsaVariantsGiveTheSameBits) {
   }
   EXPECT_GT(contacts, 0u) << "no wisp-wisp contact: the narrow phase found nothing to compare";
   EXPECT_EQ(metrics::state_hash(best.positions()), metrics::state_hash(base.positions()))
-      << kernels::wisp_soa::kernels_isa();
+      << kernels::simd::isa_name(kernels::simd::runtime_isa());
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The Vulkan backend (kernels/vulkan, models/han_vk) on whatever Vulkan device the
+// The Vulkan backend (kernels/vulkan, models/han2012/vulkan/) on whatever Vulkan device the
 // machine has (lavapipe, a CPU device, in CI): the runtime, agreement with the CPU
 // models, strands that do not fill a workgroup or overflow one, the invocations per
 // strand each method takes, the staged readback a discrete GPU takes (forced on
@@ -6,7 +6,7 @@
 // scenario agreements and the stability sweep are in vulkan_agreement_test.cpp (label slow).
 #include "cli_support.h"
 #include "kernels/vulkan/runtime.h"
-#include "models/han_vk/model.h"
+#include "models/han2012/vulkan/model.h"
 #include "vulkan_support.h"
 
 #include <cmath>

@@ -36,7 +36,7 @@ void BM_PlanteStyle(benchmark::State& state) {
   state.counters["segments_per_wisp"] = total.segments_per_wisp;
   state.counters["ms_per_sim_s"] = total.step_ms / total.sim_s;
   state.counters["s_for_264_frames"] = total.step_ms / total.sim_s * 264.0 / 24.0 / 1000.0;
-  for (const char* stage : {"integration", "body_collision", "self_interaction", "rebuild"})
+  for (const char* stage : {"integrate", "body_collision", "self_interaction", "rebuild"})
     state.counters[std::string(stage) + "_share"] = stage_ms[stage] / total.step_ms;
   state.counters["interaction_share"] = interactions / total.step_ms;
   state.counters["self_of_interactions"] = interactions > 0.0 ? stage_ms["self_interaction"] / interactions : 0.0;

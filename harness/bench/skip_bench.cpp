@@ -84,11 +84,9 @@ void bm_settled(benchmark::State& state, const ModelInfo* info, const char* scen
   time_frames(state, *model, sc, first);
 }
 
-bool is_cpu(const ModelInfo& m) { return std::string_view(m.name).find("_vk") == std::string_view::npos; }
-
 const bool registered = [] {
   for (const ModelInfo& m : model_registry()) {
-    if (!is_cpu(m)) continue;
+    if (m.platform != Platform::Cpu) continue;
     const std::string model(m.name);
     for (const Feature& f : features())
       for (bool on : {true, false})

@@ -4,7 +4,7 @@
 // (scenarios/paper). Without a Vulkan device every benchmark is skipped with the reason.
 #include "core/parallel.h"
 #include "harness/runner.h"
-#include "models/han_vk/model.h"
+#include "models/han2012/vulkan/model.h"
 #include "scenarios/scenario.h"
 
 #include <benchmark/benchmark.h>

@@ -9,9 +9,10 @@
 // `contacts` says how many.
 #include "core/parallel.h"
 #include "harness/runner.h"
-#include "kernels/cpu/wisp_grid.h"
-#include "kernels/cpu/wisp_soa.h"
-#include "models/plante_wisp/model.h"
+#include "kernels/simd/isa.h"
+#include "kernels/plante2001/wisp_grid.h"
+#include "kernels/plante2001/fused/wisp_soa.h"
+#include "models/plante2001/model.h"
 #include "models/registry.h"
 #include "scenarios/scenario.h"
 
@@ -68,7 +69,7 @@ void bm_wisp_narrow_phase(benchmark::State& state, bool fast) {
     benchmark::DoNotOptimize(out.data());
   }
   state.counters["contacts"] = static_cast<double>(out.size());
-  if (fast) state.SetLabel(kernels::wisp_soa::kernels_isa());
+  if (fast) state.SetLabel(kernels::simd::isa_name(kernels::simd::runtime_isa()));
 }
 
 BENCHMARK(bm_wisp_grid)->Name("BM_wisp_grid")->Unit(benchmark::kMillisecond);

@@ -1,0 +1,80 @@
+#include "kernels/common/strand_kernels.h"
+
+#include <cmath>
+
+namespace hairbench::kernels {
+
+namespace {
+Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
+}  // namespace
+
+void follow_head(std::span<Vec4f> pos, std::span<Vec4f> prev, std::span<const Vec4f> rest,
+                 const Affine3f& head) {
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (rest[i].w() != 0.0f) continue;
+    prev[i] = pos[i];
+    pos[i].head<3>() = head * xyz(rest[i]);
+  }
+}
+
+void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& gravity,
+                      const Wind& wind, bool wind_term, float damping, float dt) {
+  const float keep = 1.0f - damping;
+  const float dt2 = dt * dt;
+  const Vec3f wind_acc = wind.acceleration();
+  for (std::size_t i = 1; i < pos.size(); ++i) {
+    if (pos[i].w() == 0.0f) continue;
+    Vec3f acc = gravity;
+    if (wind_term) {
+      const Vec3f edge = xyz(pos[i]) - xyz(pos[i - 1]);
+      const float len2 = edge.squaredNorm();
+      const Vec3f t = len2 > 0.0f ? Vec3f(edge / std::sqrt(len2)) : Vec3f::Zero();
+      acc += wind_acc - wind_acc.dot(t) * t;
+    }
+    const Vec3f p = xyz(pos[i]);
+    pos[i].head<3>() = p + keep * (p - xyz(prev[i])) + acc * dt2;
+    prev[i].head<3>() = p;
+  }
+}
+
+void edge_length(std::span<Vec4f> pos, std::span<const float> rest_length) {
+  const std::size_t n = pos.size();
+  for (std::size_t first : {std::size_t{1}, std::size_t{2}})
+    for (std::size_t i = first; i < n; i += 2) {
+      Vec4f& a = pos[i - 1];
+      Vec4f& b = pos[i];
+      const float wsum = a.w() + b.w();
+      if (wsum == 0.0f) continue;
+      const Vec3f d = xyz(b) - xyz(a);
+      const float len = d.norm();
+      if (!(len > 0.0f)) continue;
+      const Vec3f corr = d * ((len - rest_length[i]) / (len * wsum));
+      a.head<3>() += a.w() * corr;
+      b.head<3>() -= b.w() * corr;
+    }
+}
+
+void collide_spheres(std::span<Vec4f> pos, std::span<const Vec4f> world_spheres) {
+  if (world_spheres.empty()) return;
+  constexpr int kPasses = 4;
+  for (Vec4f& p : pos) {
+    if (p.w() == 0.0f) continue;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      bool moved = false;
+      for (const Vec4f& s : world_spheres) {
+        const Vec3f d = xyz(p) - xyz(s);
+        const float r = s.w();
+        const float dist2 = d.squaredNorm();
+        if (dist2 >= r * r) continue;
+        const float dist = std::sqrt(dist2);
+        // A vertex exactly at the centre has no closest point; push it straight up.
+        const Vec3f n = dist > 0.0f ? Vec3f(d / dist) : Vec3f::UnitY();
+        p.head<3>() = xyz(s) + n * r;
+        moved = true;
+      }
+      if (!moved) break;
+    }
+  }
+}
+
+}  // namespace hairbench::kernels

@@ -1,0 +1,34 @@
+// The building blocks two papers share (Han & Harada's and Halén & Wester's
+// position-based strand models), as pure functions over one strand's plain arrays
+// (positions are float4: xyz + inverse mass w). Every model that uses positions calls
+// these; none re-implements them.
+#pragma once
+
+#include "core/types.h"
+
+#include <span>
+
+namespace hairbench::kernels {
+
+// Pinned vertices (w == 0) follow the head rigidly (Han & Harada §3.2): p = T_H · p^0.
+void follow_head(std::span<Vec4f> pos, std::span<Vec4f> prev, std::span<const Vec4f> rest,
+                 const Affine3f& head);
+
+// Verlet integration with damping (Halén & Wester Eq. 4.1, Han & Harada §3.2):
+//   p' = p + (1 - damping)(p - p_prev) + a dt²   for vertices with w != 0,
+// a = gravity + the part of the wind acceleration normal to the vertex's edge (a thin
+// cylinder only catches the wind that meets it face-on). The wind term is computed only
+// when `wind_term` is set: the caller decides once per step whether there is wind.
+void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& gravity,
+                      const Wind& wind, bool wind_term, float damping, float dt);
+
+// Edge length constraints (Müller et al. 2007, Halén & Wester Eq. 4.2) in even/odd edge
+// batches (Han & Harada §5), weighted by inverse mass.
+void edge_length(std::span<Vec4f> pos, std::span<const float> rest_length);
+
+// Sphere collisions (Han & Harada §3.5): a free vertex inside a sphere moves to the
+// closest surface point. Repeated (a few passes at most) so that a push out of one sphere
+// does not leave the vertex inside another.
+void collide_spheres(std::span<Vec4f> pos, std::span<const Vec4f> world_spheres);
+
+}  // namespace hairbench::kernels

@@ -1,0 +1,133 @@
+#include "models/halen2007/reference/cascade.h"
+
+#include "core/parallel.h"
+#include "kernels/common/strand_kernels.h"
+
+namespace hairbench::halen_cascade {
+
+namespace k = hairbench::kernels;
+
+CascadeModel::CascadeModel(const ModelContext& ctx) : ctx_(ctx) {}
+
+void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
+  rest_ = rest;
+  rest_length_ = rest_edge_lengths(rest);
+  pos_ = rest.positions;
+  prev_ = rest.positions;
+  region_.clear();
+  for (std::size_t r = 0; r < rest.region_names.size(); ++r)
+    region_.push_back({static_cast<float>(params.get("damping", r)), params.get_int("length_iterations", r)});
+  substeps_ = params.get_int("substeps");
+  sleep_.reset(rest.strand_count());
+
+  frames_ = static_cast<k::CascadeFrames>(params.get_int("frames"));
+  reactions_ = params.get_int("reactions") != 0;
+  const std::size_t nv = rest.vertex_count();
+  for (auto* v : {&inv_mass_, &k_up_, &k_down_, &lift_, &lever_}) v->resize(nv);
+  base_.resize(nv);
+  rest_space_.resize(nv);
+  up_local_.resize(nv);
+  down_local_.resize(nv);
+  for (std::size_t s = 0; s < rest.strand_count(); ++s) {
+    const std::size_t r = rest.strand_region[s];
+    k::cascade_setup(strand(rest_.positions, s), static_cast<float>(params.get("stiffness", r)),
+                     static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
+                     static_cast<float>(params.get("down_fraction", r)), frames_, strand(inv_mass_, s),
+                     strand(k_up_, s), strand(k_down_, s), strand(lift_, s), strand(base_, s), strand(lever_, s),
+                     strand(rest_space_, s), strand(up_local_, s), strand(down_local_, s));
+  }
+  // The cascade's own inverse masses (vertex 1 free): follow_head moves the vertices its
+  // rest copy pins, the other kernels read the positions' w.
+  for (std::size_t i = 0; i < nv; ++i) rest_.positions[i].w() = pos_[i].w() = prev_[i].w() = inv_mass_[i];
+  space_ = rest_space_;
+  acc_.assign(nv, Vec3f::Zero());
+}
+
+std::size_t CascadeModel::state_bytes() const {
+  return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
+         (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size() + inv_mass_.size() + lever_.size()) *
+             sizeof(float) +
+         base_.size() * sizeof(int) + (rest_space_.size() + space_.size()) * sizeof(kernels::Mat3f) +
+         (up_local_.size() + down_local_.size() + acc_.size()) * sizeof(Vec3f);
+}
+
+template <class T>
+std::span<T> CascadeModel::strand(std::vector<T>& v, std::size_t s) {
+  return std::span(v).subspan(rest_.strand_begin(s), rest_.strand_size(s));
+}
+
+// Visits every awake strand; a sleeping strand is not touched.
+template <class F>
+void CascadeModel::for_each_strand(F&& f) {
+  ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s)
+      if (!sleep_.asleep(s)) f(s, region_[rest_.strand_region[s]]);
+  });
+}
+
+void CascadeModel::step(const FrameInput& in, StageTimes& times) {
+  const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
+  const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
+  if (calm && sleep_.all_asleep()) {
+    // Every strand sleeps: not even the per-strand checks run.
+    for (Stage stage : {Stage::References, Stage::Integrate, Stage::Length, Stage::Collision}) times.skip(stage);
+    return;
+  }
+  for (int i = 1; i <= substeps_; ++i) {
+    const float s = static_cast<float>(i) / static_cast<float>(substeps_);
+    substep(interpolate_head(in.head_prev, in.head, s), in, dt, times);
+  }
+  if (calm) {
+    StageTimer t(times, Stage::Sleep);
+    for_each_strand([&](std::size_t s, const RegionSettings&) { sleep_.observe(s, strand(pos_, s), strand(prev_, s), dt); });
+    sleep_.end_observe();
+  }
+}
+
+// §4.3's four steps: tangent spaces, reference nodes, simulation, correction.
+void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
+  const FramePlan plan = plan_frame(in, ctx_);
+  const k::Mat3f head_rotation = head.linear();
+  const Vec3f head_gravity = head_rotation * in.gravity;
+  {
+    StageTimer t(times, Stage::References);
+    for_each_strand([&](std::size_t s, const RegionSettings&) {
+      const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+      k::follow_head(strand(pos_, s), strand(prev_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n), head);
+      k::tangent_spaces(strand(pos_, s), head_rotation * rest_space_[b], frames_, strand(base_, s), strand(space_, s));
+      const k::CascadeStrand cs{strand(inv_mass_, s), strand(k_up_, s),   strand(k_down_, s),   strand(lift_, s),
+                                strand(base_, s),     strand(lever_, s),  strand(up_local_, s), strand(down_local_, s)};
+      k::cascade_accelerations(strand(pos_, s), strand(space_, s), cs, reactions_, in.gravity, head_gravity,
+                               strand(acc_, s));
+    });
+  }
+  {
+    StageTimer t(times, Stage::Integrate);
+    for_each_strand([&](std::size_t s, const RegionSettings& r) {
+      // Gravity is in the accelerations (cascade_accelerations).
+      k::verlet_integrate(strand(pos_, s), strand(prev_, s), Vec3f::Zero(), in.wind, plan.wind, r.damping, dt);
+      k::add_acceleration(strand(pos_, s), strand(acc_, s), dt);
+    });
+  }
+  {
+    StageTimer t(times, Stage::Length);
+    for_each_strand([&](std::size_t s, const RegionSettings& r) {
+      for (int it = 0; it < r.length_iterations; ++it) k::edge_length(strand(pos_, s), strand(rest_length_, s));
+    });
+  }
+  if (!plan.collision) {
+    times.skip(Stage::Collision);
+  } else {
+    StageTimer t(times, Stage::Collision);
+    spheres_.clear();
+    for (const Sphere& c : in.colliders) {
+      const Vec3f center = collider_center(c, head);
+      spheres_.emplace_back(center.x(), center.y(), center.z(), c.radius);
+    }
+    for_each_strand([&](std::size_t s, const RegionSettings&) { k::collide_spheres(strand(pos_, s), spheres_); });
+  }
+}
+
+std::unique_ptr<HairModel> make(const ModelContext& ctx) { return std::make_unique<CascadeModel>(ctx); }
+
+}  // namespace hairbench::halen_cascade
