@@ -8,6 +8,9 @@
 #include "reports/metrics.h"
 #include "reports/verdict.h"
 #include "scenarios/phases.h"
+#ifdef HAIRBENCH_HAS_VULKAN
+#include "models/han_vk/model.h"
+#endif
 
 #include <algorithm>
 #include <array>
@@ -221,8 +224,19 @@ std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc,
   ModelContext ctx{&pool, device};
   ctx.skip_inert = skip_inert;
   std::unique_ptr<HairModel> m = info.make(ctx);
-  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
-  if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow, &pool);
+  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow"): on
+  // the device for a Vulkan model, so that its guides need not come back to the host.
+  if (sc.follow) {
+#ifdef HAIRBENCH_HAS_VULKAN
+    if (auto* vk = dynamic_cast<han_vk::HanVkModel*>(m.get())) {
+      const tfx::FollowHairs& f = *sc.follow;
+      vk->set_follow_hairs({f.guide_offsets, f.guide, f.anchor, f.follow_offsets, f.offsets});
+      m->reset(sc.groom, params);
+      return m;
+    }
+#endif
+    m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow, &pool);
+  }
   m->reset(sc.groom, params);
   return m;
 }

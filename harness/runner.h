@@ -63,8 +63,9 @@ struct RunOptions {
   bool skip_inert = true;
 };
 
-// A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides
-// when the scenario asks for it, and reset to the groom with `params`.
+// A model ready to step the scenario: made, given the follow hairs to rebuild from the
+// guides when the scenario asks for it (a Vulkan model builds them on the device; any
+// other is wrapped in a FollowHairsAdapter), and reset to the groom with `params`.
 std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
                                       ThreadPool& pool, const std::string& device = "", bool skip_inert = true);
 // The input of frame f: the head script evaluated at both ends of the step.

@@ -2,11 +2,13 @@
 // machine has (lavapipe, a CPU device, in CI): the runtime, agreement with the CPU
 // models, strands that do not fill a workgroup or overflow one, the invocations per
 // strand each method takes, the staged readback a discrete GPU takes (forced on
-// lavapipe), and the one-line errors when there is no device. The remaining method x
-// scenario agreements and the stability sweep are in vulkan_agreement_test.cpp (label slow).
+// lavapipe), follow hairs built on the device, and the one-line errors when there is no
+// device. The remaining method x scenario agreements and the stability sweep are in
+// vulkan_agreement_test.cpp (label slow).
 #include "cli_support.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han_vk/model.h"
+#include "scenarios/tfx/tfx.h"
 #include "vulkan_support.h"
 
 #include <cmath>
@@ -208,6 +210,117 @@ TEST(VulkanModels, LanesFollowTheMethodAndChangeNoBits) {
   ::setenv("HAIRBENCH_VK_LANES", "2", 1);
   EXPECT_THROW(lanes_for("han_m1_vk", sc, sc.groom), InputError);
   ::unsetenv("HAIRBENCH_VK_LANES");
+}
+
+// tressfx_ponytail_shake with every 16th guide, and TressFX's follow hairs for them made
+// as its project makes them (4 per guide, radius 0.4 cm, tip separation 5): 309 guides,
+// 1,236 follow strands, 12 substeps.
+Scenario thin_ponytail() {
+  Scenario sc = load_scenario(find_scenario("tressfx_ponytail_shake"));
+  sc.guides = every_nth_strand(sc.guides, 16);
+  sc.follow = tfx::make_follow_hairs(sc.guides, 4, 0.004, 5.0, 7);
+  sc.groom = tfx::expand_follow_hairs(sc.guides, *sc.follow);
+  return sc;
+}
+
+// The follow hairs come from the device (follow_hairs.comp, after the step in the same
+// submission) and equal apply_follow_hairs on the device's own guides, read back, within
+// float rounding. The CPU works in double from the same float guides and rounds once; the
+// device works in float. With u = 2^-24, guide vertex g, offset d (its length |d|) and s
+// the sine of the angle between the root edge and the direction to the anchor (the
+// anchor is chosen with s >= 0.05 and, root and anchor pinned, s does not change): the
+// tangent is off by a few u (a subtraction, a dot product, a square root and a division,
+// each within 3 ulp in Vulkan); removing the tangent part from the anchor direction
+// leaves the normal off by about (5u |a|) / (s |a|), 5u / s, before its own normalisation;
+// the binormal by their sum; the three additions round at |g| + |d|, as does the CPU's one
+// rounding. So |p_vk - p_cpu| <= u (8 (|g| + |d|) + (40 / s + 40) |d|), about twice that
+// estimate.
+TEST(VulkanFollowHairs, DeviceFollowHairsAreTheCpuFormulaWithinRounding) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const tfx::FollowHairs& f = *sc.follow;
+  const ModelInfo* info = find_model("han_m3_vk");
+  ThreadPool pool(2);
+  const std::unique_ptr<HairModel> model = make_model(*info, sc, resolve_params(*info, sc, {}), pool);
+  const auto* vk = dynamic_cast<const han_vk::HanVkModel*>(model.get());
+  ASSERT_NE(vk, nullptr) << "a Vulkan model builds its follow hairs itself, unwrapped";
+  const std::size_t nv = sc.guides.vertex_count();
+  ASSERT_EQ(model->positions().size(), sc.groom.vertex_count());
+  constexpr double u = 0x1p-24;
+  std::vector<Vec4f> cpu(f.vertex_count());
+  double worst = 0.0, moved = 0.0;
+  StageTimes times;
+  for (int frame = 0; frame < 20; ++frame) {
+    times.clear();
+    model->step(frame_input(sc, frame), times);
+    for (const auto& e : times.entries()) EXPECT_NE(e.name, "follow_hairs") << "no follow hairs on the host";
+    ASSERT_TRUE(vk->last_follow_gpu_ms().has_value());
+    EXPECT_GT(*vk->last_follow_gpu_ms(), 0.0);
+    EXPECT_LT(*vk->last_follow_gpu_ms(), *vk->last_gpu_ms());
+    const std::span<const Vec4f> p = model->positions();
+    tfx::apply_follow_hairs(f, p.first(nv), cpu);
+    for (std::size_t s = 0; s < f.strand_count(); ++s) {
+      const std::uint32_t root = f.guide_offsets[f.guide[s]];
+      const Eigen::Vector3d p0 = p[root].head<3>().cast<double>();
+      const Eigen::Vector3d t = (p[root + 1].head<3>().cast<double>() - p0).normalized();
+      const Eigen::Vector3d a = p[f.anchor[s]].head<3>().cast<double>() - p0;
+      const double sine = a.cross(t).norm() / a.norm();
+      for (std::uint32_t v = f.follow_offsets[s]; v < f.follow_offsets[s + 1]; ++v) {
+        const std::uint32_t i = v - f.follow_offsets[s];
+        const Vec4f& g = p[root + i];
+        const Vec4f& dev = p[nv + v];
+        ASSERT_EQ(dev.w(), cpu[v].w()) << "follow strand " << s << " vertex " << i;
+        ASSERT_EQ(dev.w(), i < 2 ? 0.0f : g.w());
+        const double d = f.offsets[v].norm();
+        const double bound = u * (8.0 * (g.head<3>().norm() + d) + (40.0 / sine + 40.0) * d);
+        worst = std::max(worst, static_cast<double>((dev - cpu[v]).head<3>().norm()) / bound);
+        moved = std::max(moved, static_cast<double>((dev - sc.groom.positions[nv + v]).head<3>().norm()));
+      }
+    }
+  }
+  std::printf("device follow hairs: largest difference %.3f of the rounding bound\n", worst);
+  EXPECT_LE(worst, 1.0);
+  EXPECT_GT(moved, 0.01) << "the shake should move the follow hairs by centimetres";
+}
+
+// Through the runner: han_m3_vk with its follow hairs on the device against han_m3 with
+// them rebuilt on the host (FollowHairsAdapter), the full groom every frame. The guides
+// agree as in the other agreement tests; the follow hairs add only their rounding.
+TEST(VulkanFollowHairs, RunnerAgreesWithTheCpuModelOnTheFullGroom) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  ThreadPool pool(2);
+  RunOptions opt;
+  opt.models = {"han_m3_vk"};
+  opt.reference = "han_m3";
+  opt.frames = 60;
+  const auto runs = run_scenario(sc, opt, pool);
+  ASSERT_EQ(runs.size(), 1u);
+  const RunRecord& r = runs[0];
+  ASSERT_FALSE(r.failure) << r.failure->reason;
+  EXPECT_LT(test::max_of(r.deviation), 1e-4);
+  EXPECT_GT(test::max_of(r.rest_shape_error), 0.01) << "the shake should move the hair";
+  EXPECT_EQ(r.stage_ms_total.count("follow_hairs"), 0u);
+  EXPECT_EQ(r.gpu_ms.size(), 60u);
+}
+
+// A follow layout that does not fit its guides is refused before it reaches the device.
+TEST(VulkanFollowHairs, RefusesAnInconsistentLayout) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const tfx::FollowHairs& f = *sc.follow;
+  han_vk::HanVkModel model(han::Method::RestFrames, ModelContext{});
+  std::vector<std::uint32_t> anchor = f.anchor;
+  anchor[3] = sc.guides.vertex_count();
+  EXPECT_THROW(model.set_follow_hairs({f.guide_offsets, f.guide, anchor, f.follow_offsets, f.offsets}),
+               std::invalid_argument);
+  std::vector<std::uint32_t> guide = f.guide;
+  guide[0] = static_cast<std::uint32_t>(sc.guides.strand_count());
+  EXPECT_THROW(model.set_follow_hairs({f.guide_offsets, guide, f.anchor, f.follow_offsets, f.offsets}),
+               std::invalid_argument);
+  // A layout made for other guides does not fit this groom.
+  model.set_follow_hairs({f.guide_offsets, f.guide, f.anchor, f.follow_offsets, f.offsets});
+  EXPECT_THROW(model.reset(sc.guides, resolve_params(*find_model("han_m3_vk"), sc, {})), std::logic_error);
 }
 
 using test::run_cli;
