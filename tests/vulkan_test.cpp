@@ -2,10 +2,12 @@
 // machine has (lavapipe, a CPU device, in CI): the runtime, agreement with the CPU
 // models, strands that do not fill a workgroup or overflow one, the invocations per
 // strand each method takes, the staged readback a discrete GPU takes (forced on
-// lavapipe), follow hairs built on the device, and the one-line errors when there is no
-// device. The remaining method x scenario agreements and the stability sweep are in
-// vulkan_agreement_test.cpp (label slow).
+// lavapipe), follow hairs built on the device, the warm-up, the device times and GPU
+// clock in the report, and the one-line errors when there is no device. The remaining
+// method x scenario agreements and the stability sweep are in vulkan_agreement_test.cpp
+// (label slow).
 #include "cli_support.h"
+#include "harness/gpu_clock.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han_vk/model.h"
 #include "scenarios/tfx/tfx.h"
@@ -15,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 
@@ -302,6 +305,28 @@ TEST(VulkanFollowHairs, RunnerAgreesWithTheCpuModelOnTheFullGroom) {
   EXPECT_GT(test::max_of(r.rest_shape_error), 0.01) << "the shake should move the hair";
   EXPECT_EQ(r.stage_ms_total.count("follow_hairs"), 0u);
   EXPECT_EQ(r.gpu_ms.size(), 60u);
+  EXPECT_EQ(r.gpu_ms_lockstep.size(), 60u);
+}
+
+// The warm-up runs the step back to back and leaves the state as it was: a model warmed
+// up in mid-run goes on bit for bit like one that was not (method 2 keeps frames across
+// steps, and follow hairs are written by a second dispatch: both are put back).
+TEST(VulkanModels, WarmUpLeavesTheStateAsItWas) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const ModelInfo* info = find_model("han_m2_vk");
+  ThreadPool pool(1);
+  const ParamSet params = resolve_params(*info, sc, {});
+  const std::unique_ptr<HairModel> plain = make_model(*info, sc, params, pool);
+  const std::unique_ptr<HairModel> warmed = make_model(*info, sc, params, pool);
+  StageTimes times;
+  for (int frame = 0; frame < 8; ++frame) {
+    if (frame == 4) warmed->warm_up(frame_input(sc, 30), 0.0);
+    plain->step(frame_input(sc, frame), times);
+    warmed->step(frame_input(sc, frame), times);
+    const std::span<const Vec4f> a = plain->positions(), b = warmed->positions();
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size_bytes()), 0) << "frame " << frame;
+  }
 }
 
 // A follow layout that does not fit its guides is refused before it reaches the device.
@@ -375,11 +400,14 @@ TEST(VulkanCli, StagedCompareGivesTheMappedReport) {
   }
 }
 
-// The report carries the device time and the device (timing.gpu_ms, run.device,
-// context.devices) for the Vulkan models, and nothing new for the CPU ones.
+// The report carries the device times and the device (timing.gpu_ms back to back,
+// gpu_ms_lockstep, gpu_clock_mhz, run.device, context.devices) for the Vulkan models, and
+// nothing new for the CPU ones. Without nvidia-smi there is no clock to read: null, and why.
 TEST(VulkanCli, ReportHasGpuTime) {
   HAIRBENCH_REQUIRE_VULKAN();
-  const test::CliResult r = run_cli("compare --scenario idle --frames 3 --models 'han_m3(_vk)?' --device 0 --out /tmp/hairbench-vk-report");
+  const test::CliResult r = run_cli(
+      "compare --scenario idle --frames 3 --models 'han_m3(_vk)?' --device 0 --no-charts --out /tmp/hairbench-vk-report",
+      "env PATH=/nonexistent ");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in("/tmp/hairbench-vk-report/report.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -388,12 +416,77 @@ TEST(VulkanCli, ReportHasGpuTime) {
   const auto& gpu = j["runs"][1];
   EXPECT_EQ(cpu["backend"], "cpu");
   EXPECT_FALSE(cpu["timing"].contains("gpu_ms"));
+  EXPECT_FALSE(cpu["timing"].contains("gpu_ms_lockstep"));
   EXPECT_EQ(gpu["model"], "han_m3_vk");
   EXPECT_EQ(gpu["backend"], "vulkan");
   EXPECT_GT(gpu["timing"]["gpu_ms"]["median"].get<double>(), 0.0);
+  EXPECT_GT(gpu["timing"]["gpu_ms_lockstep"]["median"].get<double>(), 0.0);
+  EXPECT_TRUE(gpu["timing"]["gpu_clock_mhz"].is_null());
   EXPECT_EQ(gpu["series"]["gpu_ms"].size(), 3u);
+  EXPECT_EQ(gpu["series"]["gpu_ms_lockstep"].size(), 3u);
   ASSERT_EQ(j["context"]["devices"].size(), 1u);
-  EXPECT_EQ(j["context"]["devices"][0], gpu["device"]);
+  const auto& device = j["context"]["devices"][0];
+  EXPECT_EQ(device["name"], gpu["device"]);
+  EXPECT_EQ(device["type"], vk::Context::get("0")->device().type);
+  EXPECT_GT(device["timestamp_period_ns"].get<double>(), 0.0);
+  EXPECT_TRUE(device["clock_mhz"].is_null());
+  EXPECT_EQ(device["clock_source"].get<std::string>().rfind("not queryable: ", 0), 0u) << device;
+}
+
+// A directory holding a stand-in nvidia-smi that prints `lines`, for PATH.
+std::filesystem::path fake_nvidia_smi(const std::string& name, const std::string& lines) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("hairbench-fake-smi-" + name);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "nvidia-smi") << "#!/bin/sh\ncat <<'EOF'\n" << lines << "EOF\n";
+  std::filesystem::permissions(dir / "nvidia-smi", std::filesystem::perms::owner_all);
+  return dir;
+}
+
+// Where nvidia-smi answers, the report has the clock: at the command's start and end in
+// context.devices, after each run's back-to-back steps in timing.gpu_clock_mhz.
+TEST(VulkanCli, ReportHasTheClockNvidiaSmiReads) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const std::string name = vk::Context::get("0")->device().name;
+  const auto dir = fake_nvidia_smi("report", "Another GPU, 300, 900\n" + name + ", 1410, 1980\n");
+  const test::CliResult r = run_cli("compare --scenario idle --frames 2 --models han_m3_vk --reference han_m3_vk "
+                                    "--device 0 --no-charts --out /tmp/hairbench-vk-clock",
+                                    "env PATH=" + dir.string() + ":/usr/bin:/bin ");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in("/tmp/hairbench-vk-clock/report.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& device = j["context"]["devices"][0];
+  EXPECT_EQ(device["clock_source"], "nvidia-smi");
+  EXPECT_EQ(device["clock_mhz"], nlohmann::json({{"start", 1410.0}, {"end", 1410.0}, {"max", 1980.0}}));
+  EXPECT_EQ(j["runs"][0]["timing"]["gpu_clock_mhz"], 1410.0);
+  EXPECT_NE(r.out.find("at 1410 MHz"), std::string::npos) << r.out;
+}
+
+// nvidia-smi's lines are "NAME, SM CLOCK, MAX SM CLOCK" (names may hold commas); a clock it
+// cannot give is "[N/A]"; the Vulkan device is found by name, and only when one GPU has it.
+TEST(GpuClock, ReadsNvidiaSmiByDeviceName) {
+  const char* old = std::getenv("PATH");
+  const std::string path = old ? old : "/usr/bin:/bin";
+  const auto with = [&](const std::string& tag, const std::string& lines, const std::string& device) {
+    ::setenv("PATH", (fake_nvidia_smi(tag, lines).string() + ":" + path).c_str(), 1);
+    const GpuClock c = read_gpu_clock(device);
+    ::setenv("PATH", path.c_str(), 1);
+    return c;
+  };
+  const GpuClock comma = with("comma", "llvmpipe (LLVM 15.0.6, 256 bits), 1200, [N/A]\n", "llvmpipe (LLVM 15.0.6, 256 bits)");
+  EXPECT_EQ(comma.source, "nvidia-smi");
+  EXPECT_EQ(comma.mhz, 1200.0);
+  EXPECT_FALSE(comma.max_mhz);
+  const GpuClock none = with("none", "NVIDIA H100 80GB HBM3, 1980, 1980\n", "NVIDIA H200");
+  EXPECT_FALSE(none.mhz);
+  EXPECT_EQ(none.source, "not queryable: nvidia-smi lists no GPU named 'NVIDIA H200'");
+  const GpuClock two = with("two", "NVIDIA H200, 1980, 1980\nNVIDIA H200, 345, 1980\n", "NVIDIA H200");
+  EXPECT_FALSE(two.mhz);
+  EXPECT_NE(two.source.find("2 GPUs named 'NVIDIA H200'"), std::string::npos) << two.source;
+  ::setenv("PATH", "/nonexistent", 1);
+  const GpuClock absent = read_gpu_clock("NVIDIA H200");
+  ::setenv("PATH", path.c_str(), 1);
+  EXPECT_FALSE(absent.mhz);
+  EXPECT_EQ(absent.source.rfind("not queryable: Vulkan has no clock query", 0), 0u) << absent.source;
 }
 
 }  // namespace

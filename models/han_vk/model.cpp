@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -285,6 +286,27 @@ void HanVkModel::step(const FrameInput& in, StageTimes& times) {
   gpu_ms_ = commands_->last_ms();
   if (follow_kernel_) follow_gpu_ms_ = commands_->last_ms(1);
   host_current_ = false;
+}
+
+// The device's first runs of a pipeline can be slow (compilation, cold caches) and an
+// idle GPU runs at a low clock until work keeps it busy (docs/vulkan.md, Timing).
+void HanVkModel::warm_up(const FrameInput& in, double seconds) {
+  const vk::Context& ctx = *context_;
+  // What a step changes, kept aside on the device.
+  const vk::Buffer pos = ctx.buffer(pos_.size(), vk::Memory::Device);
+  const vk::Buffer prev = ctx.buffer(prev_.size(), vk::Memory::Device);
+  const vk::Buffer rot = ctx.buffer(rot_.size(), vk::Memory::Device);
+  ctx.copy(pos_, pos);
+  ctx.copy(prev_, prev);
+  ctx.copy(rot_, rot);
+  upload_frame(in);
+  const auto start = std::chrono::steady_clock::now();
+  for (int runs = 0; runs < 2 || std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < seconds;
+       ++runs)
+    commands_->run();
+  ctx.copy(pos, pos_);
+  ctx.copy(prev, prev_);
+  ctx.copy(rot, rot_);
 }
 
 std::span<const Vec4f> HanVkModel::positions() const {

@@ -45,6 +45,9 @@ class HanVkModel final : public HairModel {
   // Uploads the frame's inputs, runs the dispatches and waits for them (stages "upload",
   // "dispatch"; their device time is last_gpu_ms()).
   void step(const FrameInput& in, StageTimes& out_times) override;
+  // Runs the step with `in` back to back for `seconds` (twice at least) and puts the state
+  // back as it was, on the device.
+  void warm_up(const FrameInput& in, double seconds) override;
   // Reads the positions (the follow hairs' too) back on the first call after a step.
   std::span<const Vec4f> positions() const override;
   Backend backend() const override { return {"vulkan", context_->device().name}; }
