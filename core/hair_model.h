@@ -121,6 +121,9 @@ class HairModel {
   // Device time of the last step() from GPU timestamps (report timing.gpu_ms); nullopt
   // for models that do not run on a GPU.
   virtual std::optional<double> last_gpu_ms() const { return std::nullopt; }
+  // Before timing: GPU models run their step with `in` back to back for `seconds` (the
+  // pipeline compiled, the clock up) and leave their state as it was; nothing elsewhere.
+  virtual void warm_up(const FrameInput& /*in*/, double /*seconds*/) {}
 };
 
 }  // namespace hairbench

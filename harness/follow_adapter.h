@@ -1,6 +1,7 @@
-// Runs a model on the guide strands of an imported groom and rebuilds the follow hairs
+// Runs a CPU model on the guide strands of an imported groom and rebuilds the follow hairs
 // from them after every step, as TressFX does: the follow strands cost no simulation, and
-// the metrics still see the full groom.
+// the metrics still see the full groom. (The Vulkan models build them on the device:
+// make_model in harness/runner.cpp.)
 #pragma once
 
 #include "core/hair_model.h"

@@ -5,6 +5,7 @@
 #include "core/parallel.h"
 #include "git_sha.h"
 #include "harness/charts.h"
+#include "harness/gpu_clock.h"
 #include "harness/progress.h"
 #include "harness/reproduce.h"
 #include "harness/runner.h"
@@ -212,6 +213,12 @@ void print_run(const nlohmann::json& r) {
               f(r["timing"]["ns_per_vertex"], "%.1f").c_str(), f(m["deviation_vs_reference"]["rms"], "%.3g").c_str(),
               f(m["jaggedness"]["mean"], "%.3g").c_str(), f(m["length_error"]["rms"], "%.2g").c_str(),
               f(m["rest_shape_error"], "%.3g").c_str());
+  // GPU runs: the device time back to back and in lockstep (docs/vulkan.md, Timing).
+  const auto& t = r["timing"];
+  if (t.contains("gpu_ms"))
+    std::printf("  %-14s gpu %s ms back to back at %s MHz, %s ms in lockstep\n", "",
+                f(t["gpu_ms"]["median"], "%.4f").c_str(), f(t["gpu_clock_mhz"], "%.0f").c_str(),
+                t.contains("gpu_ms_lockstep") ? f(t["gpu_ms_lockstep"]["median"], "%.4f").c_str() : "-");
   // Every class but ok says why, and where it was decided.
   const auto& v = r["verdict"];
   if (v["class"] != "ok") {
@@ -222,11 +229,37 @@ void print_run(const nlohmann::json& r) {
   }
 }
 
-// The report, then the chart step (reports/charts.py) unless --no-charts.
-int write_report(const CompareArgs& a, const ThreadPool& pool, const std::vector<RunRecord>& runs,
-                 const std::vector<ScenarioRecord>& scenarios, const nlohmann::json& sweep) {
+// The GPU that the selected models (or the reference) run on, with its clock as the
+// command starts (context.devices); none when every model runs on the CPU.
+std::vector<DeviceRecord> gpu_devices(const CompareArgs& a) {
+  std::vector<DeviceRecord> out;
+#ifdef HAIRBENCH_HAS_VULKAN
+  std::vector<std::string> names = a.run.models;
+  if (!a.run.reference.empty()) names.push_back(a.run.reference);
+  for (const std::string& name : names) {
+    const ModelInfo* m = find_model(name);
+    if (!m || !m->unavailable) continue;
+    const vk::DeviceInfo& d = vk::Context::get(a.run.device)->device();
+    const GpuClock clock = read_gpu_clock(d.name);
+    out.push_back({d.name, d.type, d.timestamp_period_ns, clock.mhz, {}, clock.max_mhz, clock.source});
+    break;
+  }
+#endif
+  return out;
+}
+
+// The report, then the chart step (reports/charts.py) unless --no-charts. The devices'
+// clocks are read again as it is written.
+int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<DeviceRecord> devices,
+                 const std::vector<RunRecord>& runs, const std::vector<ScenarioRecord>& scenarios,
+                 const nlohmann::json& sweep) {
+  for (DeviceRecord& d : devices) {
+    const GpuClock clock = read_gpu_clock(d.name);
+    d.clock_end_mhz = clock.mhz;
+    if (!d.clock_max_mhz) d.clock_max_mhz = clock.max_mhz;
+  }
   const std::filesystem::path out = std::filesystem::path(a.out) / "report.json";
-  nlohmann::json report = make_report(ReportContext{pool.threads()}, runs, scenarios);
+  nlohmann::json report = make_report(ReportContext{pool.threads(), std::move(devices)}, runs, scenarios);
   if (!sweep.is_null()) report["sweep"] = sweep;
   write_json(out, report);
   std::printf("wrote %s\n", out.string().c_str());
@@ -250,6 +283,7 @@ void print_header(const Scenario& sc, const CompareArgs& a) {
 int cmd_compare(CompareArgs& a) {
   prepare_compare(a, false);
   const std::vector<Scenario> scenarios = load_scenarios(a);
+  std::vector<DeviceRecord> devices = gpu_devices(a);
 
   ThreadPool pool(a.threads);
   Progress progress(static_cast<int>(scenarios.size() * a.run.models.size()), true);
@@ -268,7 +302,7 @@ int cmd_compare(CompareArgs& a) {
     std::fflush(stdout);
     for (RunRecord& r : got) runs.push_back(std::move(r));
   }
-  return write_report(a, pool, runs, records, nullptr);
+  return write_report(a, pool, std::move(devices), runs, records, nullptr);
 }
 
 // Every selected model at every knob value, one lockstep batch per value: the reference
@@ -277,6 +311,7 @@ int cmd_sweep(CompareArgs& a) {
   prepare_compare(a, true);
   const KnobSpec& knob = *a.knob;
   const std::vector<Scenario> scenarios = load_scenarios(a);
+  std::vector<DeviceRecord> devices = gpu_devices(a);
 
   ThreadPool pool(a.threads);
   const int per_batch = static_cast<int>(a.run.models.size());
@@ -304,7 +339,7 @@ int cmd_sweep(CompareArgs& a) {
     }
   }
   const nlohmann::json sweep = {{"knob", knob.name}, {"values", knob.values}, {"models", a.run.models}};
-  return write_report(a, pool, runs, records, sweep);
+  return write_report(a, pool, std::move(devices), runs, records, sweep);
 }
 
 struct StressArgs {
@@ -338,7 +373,7 @@ int cmd_stress(StressArgs& a) {
     if (done == total) std::fputc('\n', stderr);
   });
   std::fputs(stress_table(result).c_str(), stdout);
-  nlohmann::json report = make_report(ReportContext{pool.threads()}, {});
+  nlohmann::json report = make_report(ReportContext{pool.threads(), {}}, {});
   report["stress"] = stress_json(result);
   const std::filesystem::path file = std::filesystem::path(a.out) / "stress.json";
   write_json(file, report);

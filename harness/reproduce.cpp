@@ -95,9 +95,11 @@ void within_factor(ReproduceCheck& c, double f) {
 // --- Timing one model on one scenario ---------------------------------------------------
 
 // Median time of one step over `frames` frames: wall time, or the device time on a GPU.
-// One frame more is stepped first, untimed (caches, pipeline compilation).
+// One frame more is stepped first, untimed (caches), after a GPU model's warm-up
+// (pipeline compilation, the clock up).
 double time_model(const ModelInfo& info, const Scenario& sc, int frames, ThreadPool& pool, const std::string& device) {
   std::unique_ptr<HairModel> model = make_model(info, sc, resolve_params(info, sc, {}), pool, device);
+  model->warm_up(frame_input(sc, 0), kGpuWarmUpSeconds);
   StageTimes times;
   std::vector<double> ms;
   for (int f = 0; f <= frames; ++f) {
@@ -732,7 +734,7 @@ json run_reproduce(const ReproduceOptions& opt, const std::function<void(const s
   ThreadPool pool(opt.threads);
   const Ctx c{opt, pool, log};
   json report = {{"schema", "hairbench-reproduce"}, {"schema_version", 1}};
-  report["context"] = make_report(ReportContext{pool.threads()}, {})["context"];
+  report["context"] = make_report(ReportContext{pool.threads(), {}}, {})["context"];
   const double load_start = load_average();
   json papers = json::array();
   for (const std::string& p : opt.papers) {

@@ -3,11 +3,15 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/follow_adapter.h"
+#include "harness/gpu_clock.h"
 #include "harness/probe.h"
 #include "harness/roofline.h"
 #include "reports/metrics.h"
 #include "reports/verdict.h"
 #include "scenarios/phases.h"
+#ifdef HAIRBENCH_HAS_VULKAN
+#include "models/han2012/vulkan/model.h"
+#endif
 
 #include <algorithm>
 #include <array>
@@ -163,6 +167,7 @@ void take_snapshot(const Groom& g, std::span<const std::uint32_t> strands, std::
 // One model stepping through the scenario, with its record and its detectors.
 struct Lane {
   const ModelInfo* info;
+  ParamSet params;
   std::unique_ptr<HairModel> model;
   RunRecord record;
   bool reported;
@@ -198,6 +203,7 @@ class LockstepRun {
   void measure(const FrameInput& in);
   void snapshot(const FrameInput& in, int f, int frames);
   void record_scenario(int frames) const;
+  void time_gpu_lanes();
 
   const Scenario& sc_;
   const RunOptions& opt_;
@@ -221,10 +227,33 @@ std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc,
   ModelContext ctx{&pool, device};
   ctx.skip_inert = skip_inert;
   std::unique_ptr<HairModel> m = info.make(ctx);
-  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow").
-  if (sc.follow) m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow, &pool);
+  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow"): on
+  // the device for a Vulkan model, so that its guides need not come back to the host.
+  if (sc.follow) {
+#ifdef HAIRBENCH_HAS_VULKAN
+    if (auto* vk = dynamic_cast<han_vk::HanVkModel*>(m.get())) {
+      const tfx::FollowHairs& f = *sc.follow;
+      vk->set_follow_hairs({f.guide_offsets, f.guide, f.anchor, f.follow_offsets, f.offsets});
+      m->reset(sc.groom, params);
+      return m;
+    }
+#endif
+    m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow, &pool);
+  }
   m->reset(sc.groom, params);
   return m;
+}
+
+std::vector<double> back_to_back_gpu_ms(HairModel& model, const Scenario& sc, int frames) {
+  model.warm_up(frame_input(sc, 0), kGpuWarmUpSeconds);
+  StageTimes times;
+  std::vector<double> ms;
+  for (int f = 0; f < frames; ++f) {
+    model.step(frame_input(sc, f), times);
+    model.positions();
+    if (const auto gpu = model.last_gpu_ms()) ms.push_back(*gpu);
+  }
+  return ms;
 }
 
 FrameInput frame_input(const Scenario& sc, int f) {
@@ -258,7 +287,7 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   verdict::Probe probe;
   if (opt_.probe) probe = perturbation_probe(*info, sc_, params, pool_, opt_.device);
   const bool skip = opt_.skip_inert && !(probe.run && probe.grows);
-  Lane lane{info, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
+  Lane lane{info, params, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
             metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe};
   RunRecord& r = lane.record;
   r.scenario = sc_.name;
@@ -449,8 +478,27 @@ void LockstepRun::record_scenario(int frames) const {
   out.reference_snapshots = lanes_[0].record.snapshots;
 }
 
+// In lockstep a GPU idles while the host steps the other models and measures, and may
+// drop its clock in between: on an H100 the same kernel took 3x longer in the default
+// compare than back to back (docs/vulkan.md, Timing). Each GPU lane's device time is therefore taken again on a
+// fresh copy, stepped back to back through the frames the lane ran; the lockstep times
+// are kept beside it.
+void LockstepRun::time_gpu_lanes() {
+  for (Lane& l : lanes_) {
+    RunRecord& r = l.record;
+    if (r.gpu_ms.empty()) continue;
+    r.gpu_ms_lockstep = std::move(r.gpu_ms);
+    const std::unique_ptr<HairModel> fresh = make_model(*l.info, sc_, l.params, pool_, opt_.device, opt_.skip_inert);
+    r.gpu_ms = back_to_back_gpu_ms(*fresh, sc_, static_cast<int>(r.step_ms.size()));
+    r.gpu_clock_mhz = read_gpu_clock(r.device).mhz;
+  }
+}
+
 std::vector<RunRecord> LockstepRun::run() {
   make_lanes();
+  // Once every lane is made (the CPU models' probes take a while): the GPU models' clock
+  // is up as the first frame starts.
+  for (Lane& l : lanes_) l.model->warm_up(frame_input(sc_, 0), kGpuWarmUpSeconds);
   const int frames = opt_.frames > 0 ? opt_.frames : sc_.frames;
   for (Lane& l : lanes_) l.record.frames = frames;
   for (int f = 0; f < frames; ++f) {
@@ -468,6 +516,7 @@ std::vector<RunRecord> LockstepRun::run() {
     if (opt_.on_frame) opt_.on_frame(f + 1, frames);
   }
   if (opt_.scenario_record) record_scenario(frames);
+  time_gpu_lanes();
 
   std::vector<RunRecord> out;
   for (Lane& l : lanes_) {

@@ -63,12 +63,21 @@ struct RunOptions {
   bool skip_inert = true;
 };
 
-// A model ready to step the scenario: made, wrapped to rebuild follow hairs from guides
-// when the scenario asks for it, and reset to the groom with `params`.
+// A model ready to step the scenario: made, given the follow hairs to rebuild from the
+// guides when the scenario asks for it (a Vulkan model builds them on the device; any
+// other is wrapped in a FollowHairsAdapter), and reset to the groom with `params`.
 std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc, const ParamSet& params,
                                       ThreadPool& pool, const std::string& device = "", bool skip_inert = true);
 // The input of frame f: the head script evaluated at both ends of the step.
 FrameInput frame_input(const Scenario& sc, int f);
+
+// How long a GPU model steps back to back before its steps are timed (HairModel::warm_up):
+// long enough for a GPU's clock to come up from idle (docs/vulkan.md, Timing).
+inline constexpr double kGpuWarmUpSeconds = 0.2;
+// Device time of each of the scenario's first `frames` steps of a freshly reset GPU model,
+// stepped back to back after a warm-up, each followed by positions() (as BM_HanVk does):
+// the device time that does not depend on what runs beside the model.
+std::vector<double> back_to_back_gpu_ms(HairModel& model, const Scenario& sc, int frames);
 
 // The reference setting `--reference converged`: han_m1 iterated far past its defaults,
 // so that every model's deviation from it is an absolute error (method 1's included).
@@ -80,7 +89,9 @@ std::vector<ParamOverride> converged_reference_overrides();
 std::vector<std::uint32_t> snapshot_strands(const Groom& groom);
 
 // Runs one scenario; a model that diverges stops there (RunRecord::failure) and the
-// others go on; every run ends with its verdict (reports/verdict.h). Every run records
+// others go on; every run ends with its verdict (reports/verdict.h). A GPU model is warmed
+// up before its first step, and after the lockstep run a fresh copy steps the same frames
+// back to back for its device time (RunRecord::gpu_ms). Every run records
 // the scenario's two snapshot frames:
 // the most violent one, where the reference's kinetic energy per unit mass relative to
 // the head, mean |p(t) - H(t) H(t-dt)^-1 p(t-dt)|^2 / (2 dt^2), is highest (the first such

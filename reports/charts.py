@@ -23,7 +23,8 @@ Writes next to the report (or into DIR), STEM being the report's file name witho
 PNGs are written with a 256-colour palette (a few hundred kilobytes for a default compare's
 pictures). --svg (or HAIRBENCH_SVG=1 in the environment, for the hairbench CLI) also writes
 every chart as SVG, the strand lines rasterized inside it. Reads schema_version 1 (snapshot
-strands as coordinate lists) and 2 (encoded strands, see decode_strand).
+strands as coordinate lists), 2 (encoded strands, see decode_strand) and 3 (context.devices
+as objects with the GPU clock).
 
 Needs Python 3 with matplotlib (Debian: python3-matplotlib). Exit codes: 0 done; 2 the
 report cannot be read; 3 matplotlib cannot be imported (the hairbench CLI relies on it).
@@ -60,7 +61,7 @@ PHASE_COLOURS = {"move": "tab:blue", "oscillate": "tab:orange", "wind": "tab:gre
 # Stages in the order a step runs them: the order of core/stage.h's name table.
 STAGE_ORDER = ["upload", "dispatch", "references", "pose", "integrate", "global_shape", "local_shape", "length",
                "collision", "body_collision", "self_interaction", "rebuild", "follow_hairs", "sleep"]
-SCHEMA_VERSIONS = (1, 2)
+SCHEMA_VERSIONS = (1, 2, 3)
 # Distinct stage colours: tab20's saturated then light halves, its greys left out (grey
 # is "untimed").
 STAGE_PALETTE = [plt.get_cmap("tab20")(i) for i in list(range(0, 14, 2)) + [16, 18] + list(range(1, 14, 2)) + [17, 19]]
@@ -635,10 +636,24 @@ def scenario_notes(report, name):
     return notes
 
 
+def device_text(d):
+    """A GPU of context.devices: its name (all that versions 1 and 2 give), and its clock
+    at the start and end of the run where it was read."""
+    if isinstance(d, str):
+        return d
+    clock = d.get("clock_mhz") or {}
+    if clock.get("start") is None and clock.get("end") is None:
+        return f"{d.get('name', '?')} (clock not read)"
+    return f"{d.get('name', '?')} ({fmt(clock.get('start'), '.0f')} → {fmt(clock.get('end'), '.0f')} MHz)"
+
+
 def context_line(report):
     c = report.get("context", {})
-    return (f"{c.get('date', '?')} · git {c.get('git_sha', '?')} · {c.get('cpu', '?')} · "
+    line = (f"{c.get('date', '?')} · git {c.get('git_sha', '?')} · {c.get('cpu', '?')} · "
             f"{c.get('threads', '?')} threads · {c.get('build_type', '?')} · {c.get('compiler', '?')}")
+    for d in c.get("devices", []):
+        line += f" · GPU {device_text(d)}"
+    return line
 
 
 def write_markdown(report, path, pareto_by_scenario):

@@ -193,7 +193,33 @@ double percentile(std::vector<double> v, double q) {
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+namespace {
+
+nlohmann::json opt_num(const std::optional<double>& v) { return v ? num(*v) : nlohmann::json(nullptr); }
+
+nlohmann::json device_json(const DeviceRecord& d) {
+  nlohmann::json clock = nullptr;
+  if (d.clock_start_mhz || d.clock_end_mhz || d.clock_max_mhz)
+    clock = {{"start", opt_num(d.clock_start_mhz)}, {"end", opt_num(d.clock_end_mhz)}, {"max", opt_num(d.clock_max_mhz)}};
+  return {{"name", d.name},
+          {"type", d.type.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.type)},
+          {"timestamp_period_ns", d.timestamp_period_ns > 0.0 ? num(d.timestamp_period_ns) : nlohmann::json(nullptr)},
+          {"clock_mhz", clock},
+          {"clock_source", d.clock_source}};
+}
+
+nlohmann::json summary(const std::vector<double>& v) {
+  return {{"mean", num(finite_mean(v))},
+          {"median", num(median(v))},
+          {"min", num(*std::min_element(v.begin(), v.end()))},
+          {"p95", num(percentile(v, 0.95))}};
+}
+
+}  // namespace
+
 nlohmann::json context_json(const ReportContext& ctx) {
+  nlohmann::json devices = nlohmann::json::array();
+  for (const DeviceRecord& d : ctx.devices) devices.push_back(device_json(d));
   char host[256] = {};
   gethostname(host, sizeof host - 1);
   return {{"date", utc_now()},
@@ -204,7 +230,7 @@ nlohmann::json context_json(const ReportContext& ctx) {
           {"threads", ctx.threads},
           {"build_type", HAIRBENCH_BUILD_TYPE},
           {"compiler", std::string("gcc-compatible ") + __VERSION__},
-          {"devices", nlohmann::json::array()}};
+          {"devices", devices}};
 }
 
 nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
@@ -244,11 +270,11 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
     timing["state_bytes"] = r.state_bytes;
     timing["roofline_ratio"] = num(med / r.stream_ms);
   }
-  if (!r.gpu_ms.empty())
-    timing["gpu_ms"] = {{"mean", num(finite_mean(r.gpu_ms))},
-                        {"median", num(median(r.gpu_ms))},
-                        {"min", num(*std::min_element(r.gpu_ms.begin(), r.gpu_ms.end()))},
-                        {"p95", num(percentile(r.gpu_ms, 0.95))}};
+  if (!r.gpu_ms.empty()) {
+    timing["gpu_ms"] = summary(r.gpu_ms);
+    timing["gpu_clock_mhz"] = opt_num(r.gpu_clock_mhz);
+  }
+  if (!r.gpu_ms_lockstep.empty()) timing["gpu_ms_lockstep"] = summary(r.gpu_ms_lockstep);
 
   // rest_shape_error averages the frames that end at or after settle_from.
   std::vector<double> settled;
@@ -307,6 +333,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
   if (!r.device.empty()) out["device"] = r.device;
   if (!r.gpu_ms.empty()) out["series"]["gpu_ms"] = series(r.gpu_ms);
+  if (!r.gpu_ms_lockstep.empty()) out["series"]["gpu_ms_lockstep"] = series(r.gpu_ms_lockstep);
   return out;
 }
 
@@ -347,7 +374,7 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,
                            const std::vector<ScenarioRecord>& scenarios) {
   nlohmann::json j = {{"schema", "hairbench-report"},
-                      {"schema_version", 2},
+                      {"schema_version", 3},
                       {"context", context_json(ctx)},
                       {"snapshot_encoding", kSnapshotEncoding}};
   j["runs"] = nlohmann::json::array();
@@ -360,10 +387,13 @@ nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord
     j["scenarios"] = nlohmann::json::array();
     for (const ScenarioRecord& sc : scenarios) j["scenarios"].push_back(scenario_json(sc));
   }
-  for (const RunRecord& r : runs)
-    if (!r.device.empty() && std::find(j["context"]["devices"].begin(), j["context"]["devices"].end(), r.device) ==
-                                 j["context"]["devices"].end())
-      j["context"]["devices"].push_back(r.device);
+  // A device the caller did not describe is still named.
+  for (const RunRecord& r : runs) {
+    nlohmann::json& devices = j["context"]["devices"];
+    if (!r.device.empty() && std::none_of(devices.begin(), devices.end(),
+                                          [&](const nlohmann::json& d) { return d["name"] == r.device; }))
+      devices.push_back(device_json({r.device, "", 0.0, {}, {}, {}, "not recorded"}));
+  }
   return j;
 }
 

@@ -1,5 +1,5 @@
-// The hairbench-report JSON (docs/report-schema.md; schema_version 2: snapshot
-// strands encoded, see encode_snapshot_strand).
+// The hairbench-report JSON (docs/report-schema.md; schema_version 3: context.devices
+// are objects with the GPU clock; 2: snapshot strands encoded, see encode_snapshot_strand).
 #pragma once
 
 #include "core/types.h"
@@ -43,7 +43,11 @@ struct RunRecord {
   // Per frame run: 1 where the model worked (the head moved, wind blew, or some strand was
   // awake), 0 where it skipped every stage because all its strands slept.
   std::vector<std::uint8_t> worked;
-  std::vector<double> gpu_ms;  // device time per step, GPU models with timestamps only
+  // Device time per step, GPU models with timestamps only: the steps run again back to
+  // back after a warm-up (timing.gpu_ms, what BM_HanVk measures), and as they ran in
+  // lockstep, between the other models' steps and the metrics (timing.gpu_ms_lockstep).
+  std::vector<double> gpu_ms, gpu_ms_lockstep;
+  std::optional<double> gpu_clock_mhz;  // the GPU's clock right after the back-to-back steps, where known
   std::vector<double> deviation;  // NaN where the reference had already failed
   std::vector<double> jaggedness;
   std::vector<double> length_rms, length_max;
@@ -107,8 +111,18 @@ struct ScenarioRecord {
 
 inline constexpr std::size_t kMaxSnapshotStrands = 200;
 
+// A GPU the runs used (context.devices), with its clock at the start and end of the
+// command where it can be read (harness/gpu_clock.h).
+struct DeviceRecord {
+  std::string name, type;
+  double timestamp_period_ns = 0.0;  // 0: no timestamps
+  std::optional<double> clock_start_mhz, clock_end_mhz, clock_max_mhz;
+  std::string clock_source;
+};
+
 struct ReportContext {
   int threads = 1;
+  std::vector<DeviceRecord> devices;
 };
 
 nlohmann::json context_json(const ReportContext& ctx);

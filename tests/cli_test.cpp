@@ -177,7 +177,7 @@ TEST(Cli, CompareWritesTheReportContract) {
   ASSERT_TRUE(in);
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["schema"], "hairbench-report");
-  EXPECT_EQ(j["schema_version"], 2);
+  EXPECT_EQ(j["schema_version"], 3);
   for (const char* k : {"date", "git_sha", "host", "cpu", "threads", "build_type", "compiler", "devices"})
     EXPECT_TRUE(j["context"].contains(k)) << k;
   ASSERT_EQ(j["runs"].size(), 3u);

@@ -2,17 +2,22 @@
 // machine has (lavapipe, a CPU device, in CI): the runtime, agreement with the CPU
 // models, strands that do not fill a workgroup or overflow one, the invocations per
 // strand each method takes, the staged readback a discrete GPU takes (forced on
-// lavapipe), and the one-line errors when there is no device. The remaining method x
-// scenario agreements and the stability sweep are in vulkan_agreement_test.cpp (label slow).
+// lavapipe), follow hairs built on the device, the warm-up, the device times and GPU
+// clock in the report, and the one-line errors when there is no device. The remaining
+// method x scenario agreements and the stability sweep are in vulkan_agreement_test.cpp
+// (label slow).
 #include "cli_support.h"
+#include "harness/gpu_clock.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han2012/vulkan/model.h"
+#include "scenarios/tfx/tfx.h"
 #include "vulkan_support.h"
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 
@@ -210,6 +215,139 @@ TEST(VulkanModels, LanesFollowTheMethodAndChangeNoBits) {
   ::unsetenv("HAIRBENCH_VK_LANES");
 }
 
+// tressfx_ponytail_shake with every 16th guide, and TressFX's follow hairs for them made
+// as its project makes them (4 per guide, radius 0.4 cm, tip separation 5): 309 guides,
+// 1,236 follow strands, 12 substeps.
+Scenario thin_ponytail() {
+  Scenario sc = load_scenario(find_scenario("tressfx_ponytail_shake"));
+  sc.guides = every_nth_strand(sc.guides, 16);
+  sc.follow = tfx::make_follow_hairs(sc.guides, 4, 0.004, 5.0, 7);
+  sc.groom = tfx::expand_follow_hairs(sc.guides, *sc.follow);
+  return sc;
+}
+
+// The follow hairs come from the device (follow_hairs.comp, after the step in the same
+// submission) and equal apply_follow_hairs on the device's own guides, read back, within
+// float rounding. The CPU works in double from the same float guides and rounds once; the
+// device works in float. With u = 2^-24, guide vertex g, offset d (its length |d|) and s
+// the sine of the angle between the root edge and the direction to the anchor (the
+// anchor is chosen with s >= 0.05 and, root and anchor pinned, s does not change): the
+// tangent is off by a few u (a subtraction, a dot product, a square root and a division,
+// each within 3 ulp in Vulkan); removing the tangent part from the anchor direction
+// leaves the normal off by about (5u |a|) / (s |a|), 5u / s, before its own normalisation;
+// the binormal by their sum; the three additions round at |g| + |d|, as does the CPU's one
+// rounding. So |p_vk - p_cpu| <= u (8 (|g| + |d|) + (40 / s + 40) |d|), about twice that
+// estimate.
+TEST(VulkanFollowHairs, DeviceFollowHairsAreTheCpuFormulaWithinRounding) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const tfx::FollowHairs& f = *sc.follow;
+  const ModelInfo* info = find_model("han_m3_vk");
+  ThreadPool pool(2);
+  const std::unique_ptr<HairModel> model = make_model(*info, sc, resolve_params(*info, sc, {}), pool);
+  const auto* vk = dynamic_cast<const han_vk::HanVkModel*>(model.get());
+  ASSERT_NE(vk, nullptr) << "a Vulkan model builds its follow hairs itself, unwrapped";
+  const std::size_t nv = sc.guides.vertex_count();
+  ASSERT_EQ(model->positions().size(), sc.groom.vertex_count());
+  constexpr double u = 0x1p-24;
+  std::vector<Vec4f> cpu(f.vertex_count());
+  double worst = 0.0, moved = 0.0;
+  StageTimes times;
+  for (int frame = 0; frame < 20; ++frame) {
+    times.clear();
+    model->step(frame_input(sc, frame), times);
+    for (const auto& e : times.entries()) EXPECT_NE(e.name, "follow_hairs") << "no follow hairs on the host";
+    ASSERT_TRUE(vk->last_follow_gpu_ms().has_value());
+    EXPECT_GT(*vk->last_follow_gpu_ms(), 0.0);
+    EXPECT_LT(*vk->last_follow_gpu_ms(), *vk->last_gpu_ms());
+    const std::span<const Vec4f> p = model->positions();
+    tfx::apply_follow_hairs(f, p.first(nv), cpu);
+    for (std::size_t s = 0; s < f.strand_count(); ++s) {
+      const std::uint32_t root = f.guide_offsets[f.guide[s]];
+      const Eigen::Vector3d p0 = p[root].head<3>().cast<double>();
+      const Eigen::Vector3d t = (p[root + 1].head<3>().cast<double>() - p0).normalized();
+      const Eigen::Vector3d a = p[f.anchor[s]].head<3>().cast<double>() - p0;
+      const double sine = a.cross(t).norm() / a.norm();
+      for (std::uint32_t v = f.follow_offsets[s]; v < f.follow_offsets[s + 1]; ++v) {
+        const std::uint32_t i = v - f.follow_offsets[s];
+        const Vec4f& g = p[root + i];
+        const Vec4f& dev = p[nv + v];
+        ASSERT_EQ(dev.w(), cpu[v].w()) << "follow strand " << s << " vertex " << i;
+        ASSERT_EQ(dev.w(), i < 2 ? 0.0f : g.w());
+        const double d = f.offsets[v].norm();
+        const double bound = u * (8.0 * (g.head<3>().norm() + d) + (40.0 / sine + 40.0) * d);
+        worst = std::max(worst, static_cast<double>((dev - cpu[v]).head<3>().norm()) / bound);
+        moved = std::max(moved, static_cast<double>((dev - sc.groom.positions[nv + v]).head<3>().norm()));
+      }
+    }
+  }
+  std::printf("device follow hairs: largest difference %.3f of the rounding bound\n", worst);
+  EXPECT_LE(worst, 1.0);
+  EXPECT_GT(moved, 0.01) << "the shake should move the follow hairs by centimetres";
+}
+
+// Through the runner: han_m3_vk with its follow hairs on the device against han_m3 with
+// them rebuilt on the host (FollowHairsAdapter), the full groom every frame. The guides
+// agree as in the other agreement tests; the follow hairs add only their rounding.
+TEST(VulkanFollowHairs, RunnerAgreesWithTheCpuModelOnTheFullGroom) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  ThreadPool pool(2);
+  RunOptions opt;
+  opt.models = {"han_m3_vk"};
+  opt.reference = "han_m3";
+  opt.frames = 60;
+  const auto runs = run_scenario(sc, opt, pool);
+  ASSERT_EQ(runs.size(), 1u);
+  const RunRecord& r = runs[0];
+  ASSERT_FALSE(r.failure) << r.failure->reason;
+  EXPECT_LT(test::max_of(r.deviation), 1e-4);
+  EXPECT_GT(test::max_of(r.rest_shape_error), 0.01) << "the shake should move the hair";
+  EXPECT_EQ(r.stage_ms_total.count("follow_hairs"), 0u);
+  EXPECT_EQ(r.gpu_ms.size(), 60u);
+  EXPECT_EQ(r.gpu_ms_lockstep.size(), 60u);
+}
+
+// The warm-up runs the step back to back and leaves the state as it was: a model warmed
+// up in mid-run goes on bit for bit like one that was not (method 2 keeps frames across
+// steps, and follow hairs are written by a second dispatch: both are put back).
+TEST(VulkanModels, WarmUpLeavesTheStateAsItWas) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const ModelInfo* info = find_model("han_m2_vk");
+  ThreadPool pool(1);
+  const ParamSet params = resolve_params(*info, sc, {});
+  const std::unique_ptr<HairModel> plain = make_model(*info, sc, params, pool);
+  const std::unique_ptr<HairModel> warmed = make_model(*info, sc, params, pool);
+  StageTimes times;
+  for (int frame = 0; frame < 8; ++frame) {
+    if (frame == 4) warmed->warm_up(frame_input(sc, 30), 0.0);
+    plain->step(frame_input(sc, frame), times);
+    warmed->step(frame_input(sc, frame), times);
+    const std::span<const Vec4f> a = plain->positions(), b = warmed->positions();
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size_bytes()), 0) << "frame " << frame;
+  }
+}
+
+// A follow layout that does not fit its guides is refused before it reaches the device.
+TEST(VulkanFollowHairs, RefusesAnInconsistentLayout) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const tfx::FollowHairs& f = *sc.follow;
+  han_vk::HanVkModel model(han::Method::RestFrames, ModelContext{});
+  std::vector<std::uint32_t> anchor = f.anchor;
+  anchor[3] = sc.guides.vertex_count();
+  EXPECT_THROW(model.set_follow_hairs({f.guide_offsets, f.guide, anchor, f.follow_offsets, f.offsets}),
+               std::invalid_argument);
+  std::vector<std::uint32_t> guide = f.guide;
+  guide[0] = static_cast<std::uint32_t>(sc.guides.strand_count());
+  EXPECT_THROW(model.set_follow_hairs({f.guide_offsets, guide, f.anchor, f.follow_offsets, f.offsets}),
+               std::invalid_argument);
+  // A layout made for other guides does not fit this groom.
+  model.set_follow_hairs({f.guide_offsets, f.guide, f.anchor, f.follow_offsets, f.offsets});
+  EXPECT_THROW(model.reset(sc.guides, resolve_params(*find_model("han_m3_vk"), sc, {})), std::logic_error);
+}
+
 using test::run_cli;
 
 // Without any Vulkan driver (the loader pointed at a missing ICD): one clear line, and
@@ -262,11 +400,14 @@ TEST(VulkanCli, StagedCompareGivesTheMappedReport) {
   }
 }
 
-// The report carries the device time and the device (timing.gpu_ms, run.device,
-// context.devices) for the Vulkan models, and nothing new for the CPU ones.
+// The report carries the device times and the device (timing.gpu_ms back to back,
+// gpu_ms_lockstep, gpu_clock_mhz, run.device, context.devices) for the Vulkan models, and
+// nothing new for the CPU ones. Without nvidia-smi there is no clock to read: null, and why.
 TEST(VulkanCli, ReportHasGpuTime) {
   HAIRBENCH_REQUIRE_VULKAN();
-  const test::CliResult r = run_cli("compare --scenario idle --frames 3 --models 'han_m3(_vk)?' --device 0 --out /tmp/hairbench-vk-report");
+  const test::CliResult r = run_cli(
+      "compare --scenario idle --frames 3 --models 'han_m3(_vk)?' --device 0 --no-charts --out /tmp/hairbench-vk-report",
+      "env PATH=/nonexistent ");
   ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in("/tmp/hairbench-vk-report/report.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -275,12 +416,77 @@ TEST(VulkanCli, ReportHasGpuTime) {
   const auto& gpu = j["runs"][1];
   EXPECT_EQ(cpu["backend"], "cpu");
   EXPECT_FALSE(cpu["timing"].contains("gpu_ms"));
+  EXPECT_FALSE(cpu["timing"].contains("gpu_ms_lockstep"));
   EXPECT_EQ(gpu["model"], "han_m3_vk");
   EXPECT_EQ(gpu["backend"], "vulkan");
   EXPECT_GT(gpu["timing"]["gpu_ms"]["median"].get<double>(), 0.0);
+  EXPECT_GT(gpu["timing"]["gpu_ms_lockstep"]["median"].get<double>(), 0.0);
+  EXPECT_TRUE(gpu["timing"]["gpu_clock_mhz"].is_null());
   EXPECT_EQ(gpu["series"]["gpu_ms"].size(), 3u);
+  EXPECT_EQ(gpu["series"]["gpu_ms_lockstep"].size(), 3u);
   ASSERT_EQ(j["context"]["devices"].size(), 1u);
-  EXPECT_EQ(j["context"]["devices"][0], gpu["device"]);
+  const auto& device = j["context"]["devices"][0];
+  EXPECT_EQ(device["name"], gpu["device"]);
+  EXPECT_EQ(device["type"], vk::Context::get("0")->device().type);
+  EXPECT_GT(device["timestamp_period_ns"].get<double>(), 0.0);
+  EXPECT_TRUE(device["clock_mhz"].is_null());
+  EXPECT_EQ(device["clock_source"].get<std::string>().rfind("not queryable: ", 0), 0u) << device;
+}
+
+// A directory holding a stand-in nvidia-smi that prints `lines`, for PATH.
+std::filesystem::path fake_nvidia_smi(const std::string& name, const std::string& lines) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("hairbench-fake-smi-" + name);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "nvidia-smi") << "#!/bin/sh\ncat <<'EOF'\n" << lines << "EOF\n";
+  std::filesystem::permissions(dir / "nvidia-smi", std::filesystem::perms::owner_all);
+  return dir;
+}
+
+// Where nvidia-smi answers, the report has the clock: at the command's start and end in
+// context.devices, after each run's back-to-back steps in timing.gpu_clock_mhz.
+TEST(VulkanCli, ReportHasTheClockNvidiaSmiReads) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const std::string name = vk::Context::get("0")->device().name;
+  const auto dir = fake_nvidia_smi("report", "Another GPU, 300, 900\n" + name + ", 1410, 1980\n");
+  const test::CliResult r = run_cli("compare --scenario idle --frames 2 --models han_m3_vk --reference han_m3_vk "
+                                    "--device 0 --no-charts --out /tmp/hairbench-vk-clock",
+                                    "env PATH=" + dir.string() + ":/usr/bin:/bin ");
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in("/tmp/hairbench-vk-clock/report.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& device = j["context"]["devices"][0];
+  EXPECT_EQ(device["clock_source"], "nvidia-smi");
+  EXPECT_EQ(device["clock_mhz"], nlohmann::json({{"start", 1410.0}, {"end", 1410.0}, {"max", 1980.0}}));
+  EXPECT_EQ(j["runs"][0]["timing"]["gpu_clock_mhz"], 1410.0);
+  EXPECT_NE(r.out.find("at 1410 MHz"), std::string::npos) << r.out;
+}
+
+// nvidia-smi's lines are "NAME, SM CLOCK, MAX SM CLOCK" (names may hold commas); a clock it
+// cannot give is "[N/A]"; the Vulkan device is found by name, and only when one GPU has it.
+TEST(GpuClock, ReadsNvidiaSmiByDeviceName) {
+  const char* old = std::getenv("PATH");
+  const std::string path = old ? old : "/usr/bin:/bin";
+  const auto with = [&](const std::string& tag, const std::string& lines, const std::string& device) {
+    ::setenv("PATH", (fake_nvidia_smi(tag, lines).string() + ":" + path).c_str(), 1);
+    const GpuClock c = read_gpu_clock(device);
+    ::setenv("PATH", path.c_str(), 1);
+    return c;
+  };
+  const GpuClock comma = with("comma", "llvmpipe (LLVM 15.0.6, 256 bits), 1200, [N/A]\n", "llvmpipe (LLVM 15.0.6, 256 bits)");
+  EXPECT_EQ(comma.source, "nvidia-smi");
+  EXPECT_EQ(comma.mhz, 1200.0);
+  EXPECT_FALSE(comma.max_mhz);
+  const GpuClock none = with("none", "NVIDIA H100 80GB HBM3, 1980, 1980\n", "NVIDIA H200");
+  EXPECT_FALSE(none.mhz);
+  EXPECT_EQ(none.source, "not queryable: nvidia-smi lists no GPU named 'NVIDIA H200'");
+  const GpuClock two = with("two", "NVIDIA H200, 1980, 1980\nNVIDIA H200, 345, 1980\n", "NVIDIA H200");
+  EXPECT_FALSE(two.mhz);
+  EXPECT_NE(two.source.find("2 GPUs named 'NVIDIA H200'"), std::string::npos) << two.source;
+  ::setenv("PATH", "/nonexistent", 1);
+  const GpuClock absent = read_gpu_clock("NVIDIA H200");
+  ::setenv("PATH", path.c_str(), 1);
+  EXPECT_FALSE(absent.mhz);
+  EXPECT_EQ(absent.source.rfind("not queryable: Vulkan has no clock query", 0), 0u) << absent.source;
 }
 
 }  // namespace

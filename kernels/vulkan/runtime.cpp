@@ -195,17 +195,30 @@ int compute_family(VkPhysicalDevice d) {
   return -1;
 }
 
+// Valid bits of the compute queue family's timestamps (0: it writes none).
+std::uint32_t timestamp_bits(VkPhysicalDevice d, int family) {
+  if (family < 0) return 0;
+  std::uint32_t count = 0;
+  api.vkGetPhysicalDeviceQueueFamilyProperties(d, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  api.vkGetPhysicalDeviceQueueFamilyProperties(d, &count, families.data());
+  return families[static_cast<std::size_t>(family)].timestampValidBits;
+}
+
+DeviceInfo device_info(VkPhysicalDevice d, std::uint32_t index) {
+  VkPhysicalDeviceProperties p;
+  api.vkGetPhysicalDeviceProperties(d, &p);
+  const bool timed = timestamp_bits(d, compute_family(d)) > 0;
+  return {index, p.deviceName, type_name(p.deviceType), timed ? static_cast<double>(p.limits.timestampPeriod) : 0.0};
+}
+
 }  // namespace
 
 std::vector<DeviceInfo> list_devices() {
   std::lock_guard lock(api_mutex);
   const auto devices = physical_devices(shared_instance());
   std::vector<DeviceInfo> out;
-  for (std::uint32_t i = 0; i < devices.size(); ++i) {
-    VkPhysicalDeviceProperties p;
-    api.vkGetPhysicalDeviceProperties(devices[i], &p);
-    out.push_back({i, p.deviceName, type_name(p.deviceType)});
-  }
+  for (std::uint32_t i = 0; i < devices.size(); ++i) out.push_back(device_info(devices[i], i));
   return out;
 }
 
@@ -249,18 +262,10 @@ void Context::init(const std::string& spec) {
     throw InputError("--device", spec, "no Vulkan device with a compute queue matches (have: " + have + ")");
   }
   physical_ = devices[*pick];
-  info_ = {static_cast<std::uint32_t>(*pick), props[*pick].deviceName, type_name(props[*pick].deviceType)};
+  info_ = device_info(physical_, static_cast<std::uint32_t>(*pick));
   queue_family_ = static_cast<std::uint32_t>(compute_family(physical_));
-
-  std::uint32_t count = 0;
-  api.vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  api.vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, families.data());
-  const std::uint32_t bits = families[queue_family_].timestampValidBits;
-  if (bits > 0) {
-    timestamp_period_ns_ = props[*pick].limits.timestampPeriod;
-    timestamp_mask_ = bits >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
-  }
+  const std::uint32_t bits = timestamp_bits(physical_, static_cast<int>(queue_family_));
+  if (bits > 0) timestamp_mask_ = bits >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << bits) - 1;
   api.vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
 
   const float priority = 1.0f;
@@ -390,6 +395,11 @@ void Context::upload(Buffer& dst, const void* data, std::size_t bytes) const {
   copy(staging.handle(), dst.handle(), bytes);
 }
 
+void Context::copy(const Buffer& src, const Buffer& dst) const {
+  if (dst.size() < src.size()) throw std::logic_error("Context::copy: the destination is smaller than the source");
+  if (src.size() > 0) copy(src.handle(), dst.handle(), src.size());
+}
+
 std::unique_ptr<Readback> Context::readback(const Buffer& src) const {
   std::unique_ptr<Readback> r(new Readback(*this));
   r->size_ = src.size();
@@ -466,16 +476,14 @@ std::unique_ptr<Kernel> Context::kernel(std::span<const std::uint32_t> spirv, st
   ai.descriptorSetCount = 1;
   ai.pSetLayouts = &k->set_layout_;
   check(api.vkAllocateDescriptorSets(device_, &ai, &k->set_), "vkAllocateDescriptorSets");
-
-  k->cmd_ = new_command_buffer();
-  k->fence_ = new_fence();
-  if (timestamp_period_ns_ > 0.0) {
-    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qi.queryCount = 2;
-    check(api.vkCreateQueryPool(device_, &qi, nullptr, &k->queries_), "vkCreateQueryPool");
-  }
   return k;
+}
+
+std::unique_ptr<Commands> Context::commands() const {
+  std::unique_ptr<Commands> c(new Commands(*this));
+  c->cmd_ = new_command_buffer();
+  c->fence_ = new_fence();
+  return c;
 }
 
 // ----------------------------------------------------------------------------- Buffer
@@ -498,9 +506,6 @@ Buffer::~Buffer() {
 
 Kernel::~Kernel() {
   const VkDevice d = ctx_.device_;
-  api.vkDestroyQueryPool(d, queries_, nullptr);
-  api.vkDestroyFence(d, fence_, nullptr);
-  if (cmd_) api.vkFreeCommandBuffers(d, ctx_.command_pool_, 1, &cmd_);
   api.vkDestroyDescriptorPool(d, pool_, nullptr);
   api.vkDestroyPipeline(d, pipeline_, nullptr);
   api.vkDestroyPipelineLayout(d, layout_, nullptr);
@@ -524,38 +529,77 @@ void Kernel::bind(std::span<const Buffer* const> buffers) {
   api.vkUpdateDescriptorSets(ctx_.device_, bindings_, writes.data(), 0, nullptr);
 }
 
-void Kernel::record_dispatch(std::uint32_t groups) {
+// ----------------------------------------------------------------------------- Commands
+
+Commands::~Commands() {
+  const VkDevice d = ctx_.device_;
+  api.vkDestroyQueryPool(d, queries_, nullptr);
+  api.vkDestroyFence(d, fence_, nullptr);
+  if (cmd_) api.vkFreeCommandBuffers(d, ctx_.command_pool_, 1, &cmd_);
+}
+
+void Commands::record(std::span<const Dispatch> dispatches) {
+  const auto n = static_cast<std::uint32_t>(dispatches.size());
+  if (ctx_.info_.timestamp_period_ns > 0.0 && (!queries_ || n != recorded_)) {
+    api.vkDestroyQueryPool(ctx_.device_, queries_, nullptr);
+    queries_ = VK_NULL_HANDLE;
+    VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qi.queryCount = n + 1;
+    check(api.vkCreateQueryPool(ctx_.device_, &qi, nullptr, &queries_), "vkCreateQueryPool");
+  }
+  recorded_ = n;
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   check(api.vkBeginCommandBuffer(cmd_, &begin), "vkBeginCommandBuffer");
   if (queries_) {
-    api.vkCmdResetQueryPool(cmd_, queries_, 0, 2);
+    api.vkCmdResetQueryPool(cmd_, queries_, 0, n + 1);
     api.vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, 0);
   }
   // Host writes to the per-frame buffers are made visible by vkQueueSubmit itself.
-  api.vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  api.vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
-  api.vkCmdDispatch(cmd_, groups, 1, 1);
-  VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT;
-  api.vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                           VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
-                               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                           0, 1, &barrier, 0, nullptr, 0, nullptr);
-  if (queries_) api.vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 1);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Kernel& k = *dispatches[i].kernel;
+    api.vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, k.pipeline_);
+    api.vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, k.layout_, 0, 1, &k.set_, 0, nullptr);
+    api.vkCmdDispatch(cmd_, dispatches[i].groups, 1, 1);
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT;
+    api.vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                             VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
+                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                             0, 1, &barrier, 0, nullptr, 0, nullptr);
+    // After the barrier: the dispatch has finished when this is written.
+    if (queries_) api.vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, i + 1);
+  }
   check(api.vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
 }
 
-void Kernel::run() { ctx_.submit_and_wait(cmd_, fence_); }
+void Commands::run() { ctx_.submit_and_wait(cmd_, fence_); }
 
-std::optional<double> Kernel::last_ms() const {
-  if (!queries_) return std::nullopt;
-  std::uint64_t t[2] = {0, 0};
-  check(api.vkGetQueryPoolResults(ctx_.device_, queries_, 0, 2, sizeof t, t, sizeof t[0],
-                                  VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+std::vector<std::uint64_t> Commands::timestamps() const {
+  std::vector<std::uint64_t> t(recorded_ + 1);
+  check(api.vkGetQueryPoolResults(ctx_.device_, queries_, 0, recorded_ + 1, t.size() * sizeof t[0], t.data(),
+                                  sizeof t[0], VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
         "vkGetQueryPoolResults");
-  const std::uint64_t ticks = (t[1] - t[0]) & ctx_.timestamp_mask_;
-  return static_cast<double>(ticks) * ctx_.timestamp_period_ns_ * 1e-6;
+  return t;
+}
+
+namespace {
+double ticks_ms(std::uint64_t from, std::uint64_t to, std::uint64_t mask, double period_ns) {
+  return static_cast<double>((to - from) & mask) * period_ns * 1e-6;
+}
+}  // namespace
+
+std::optional<double> Commands::last_ms() const {
+  if (!queries_ || recorded_ == 0) return std::nullopt;
+  const std::vector<std::uint64_t> t = timestamps();
+  return ticks_ms(t.front(), t.back(), ctx_.timestamp_mask_, ctx_.info_.timestamp_period_ns);
+}
+
+std::optional<double> Commands::last_ms(std::size_t dispatch) const {
+  if (!queries_ || dispatch >= recorded_) return std::nullopt;
+  const std::vector<std::uint64_t> t = timestamps();
+  return ticks_ms(t[dispatch], t[dispatch + 1], ctx_.timestamp_mask_, ctx_.info_.timestamp_period_ns);
 }
 
 // ----------------------------------------------------------------------------- Readback

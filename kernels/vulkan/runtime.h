@@ -1,6 +1,6 @@
 // A small Vulkan compute runtime: the loader (opened at run time, so binaries start on
-// machines without Vulkan), device selection, buffers, one compute pipeline with its
-// descriptor set, command buffers, fences and timestamp queries.
+// machines without Vulkan), device selection, buffers, compute pipelines with their
+// descriptor sets, command buffers of dispatches in order, fences and timestamp queries.
 #pragma once
 
 #define VK_NO_PROTOTYPES
@@ -28,6 +28,9 @@ struct DeviceInfo {
   std::uint32_t index;
   std::string name;
   std::string type;  // "discrete GPU", "integrated GPU", "CPU", ...
+  // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod); 0 where
+  // the compute queue writes no timestamps.
+  double timestamp_period_ns = 0.0;
 };
 
 // The devices the loader reports; throws Unavailable when there is no loader or device.
@@ -70,8 +73,7 @@ class Buffer {
 enum class Memory { Device, Host };
 
 // A compute pipeline over `bindings` storage buffers (set 0) with specialization
-// constants 0..n-1, its descriptor set, and a command buffer with a fence and two
-// timestamp queries around whatever is recorded.
+// constants 0..n-1, and its descriptor set. Dispatched through Commands.
 class Kernel {
  public:
   ~Kernel();
@@ -80,17 +82,10 @@ class Kernel {
 
   // Points binding i at buffers[i].
   void bind(std::span<const Buffer* const> buffers);
-  // Records: timestamp, dispatch(groups), barrier making the writes visible to the host
-  // and to transfers, timestamp.
-  void record_dispatch(std::uint32_t groups);
-  // Submits what was recorded and waits for it.
-  void run();
-  // Device time between the two timestamps of the last run(), in ms; nullopt when the
-  // queue has no timestamps.
-  std::optional<double> last_ms() const;
 
  private:
   friend class Context;
+  friend class Commands;
   explicit Kernel(const Context& ctx) : ctx_(ctx) {}
   const Context& ctx_;
   VkShaderModule module_ = VK_NULL_HANDLE;
@@ -99,10 +94,42 @@ class Kernel {
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
+  std::uint32_t bindings_ = 0;
+};
+
+// One kernel's dispatch of `groups` workgroups.
+struct Dispatch {
+  const Kernel* kernel;
+  std::uint32_t groups;
+};
+
+// A command buffer recorded once and submitted on every run(): dispatches in order, each
+// followed by a barrier that makes its writes visible to the next dispatch, to transfers
+// and to the host, with a timestamp before the first and after each.
+class Commands {
+ public:
+  ~Commands();
+  Commands(const Commands&) = delete;
+  Commands& operator=(const Commands&) = delete;
+
+  // Records the dispatches (the kernels must outlive this recording).
+  void record(std::span<const Dispatch> dispatches);
+  // Submits what was recorded and waits for it.
+  void run();
+  // Device time of the last run(), in ms: all of it, or dispatch i alone; nullopt when
+  // the queue has no timestamps.
+  std::optional<double> last_ms() const;
+  std::optional<double> last_ms(std::size_t dispatch) const;
+
+ private:
+  friend class Context;
+  explicit Commands(const Context& ctx) : ctx_(ctx) {}
+  std::vector<std::uint64_t> timestamps() const;
+  const Context& ctx_;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
-  std::uint32_t bindings_ = 0;
+  std::uint32_t recorded_ = 0;  // dispatches in the recording
 };
 
 // Brings a device buffer's contents to the host: straight from the mapping where the
@@ -143,15 +170,19 @@ class Context {
   Buffer buffer(VkDeviceSize size, Memory where) const;
   // Copies bytes into the buffer (through a staging buffer when it is not mapped).
   void upload(Buffer& dst, const void* data, std::size_t bytes) const;
+  // Copies all of `src` into `dst` on the device and waits for the copy.
+  void copy(const Buffer& src, const Buffer& dst) const;
   // The way back for a buffer the host reads repeatedly (see Readback).
   std::unique_ptr<Readback> readback(const Buffer& src) const;
 
   std::unique_ptr<Kernel> kernel(std::span<const std::uint32_t> spirv, std::uint32_t bindings,
                                  std::span<const std::uint32_t> specialization) const;
+  std::unique_ptr<Commands> commands() const;
 
  private:
   friend class Buffer;
   friend class Kernel;
+  friend class Commands;
   friend class Readback;
   static bool staging_only();
   Context() = default;
@@ -171,8 +202,7 @@ class Context {
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   mutable std::mutex queue_mutex_;  // vkQueueSubmit from several threads (Readback::fetch)
   VkPhysicalDeviceMemoryProperties memory_{};
-  double timestamp_period_ns_ = 0.0;  // 0: the queue has no timestamps
-  std::uint64_t timestamp_mask_ = 0;
+  std::uint64_t timestamp_mask_ = 0;  // info_.timestamp_period_ns > 0 only
 };
 
 }  // namespace hairbench::vk

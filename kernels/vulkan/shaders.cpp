@@ -6,8 +6,12 @@ namespace {
 const std::uint32_t kHanStep[] =
 #include "han_step.comp.inc"
     ;
+const std::uint32_t kFollowHairs[] =
+#include "follow_hairs.comp.inc"
+    ;
 }  // namespace
 
 std::span<const std::uint32_t> han_step_spirv() { return kHanStep; }
+std::span<const std::uint32_t> follow_hairs_spirv() { return kFollowHairs; }
 
 }  // namespace hairbench::vk

@@ -1,8 +1,10 @@
-// Shared by C++ (models/han2012/vulkan/) and GLSL (han_step.comp): workgroup sizes and the
-// buffer layouts of the Vulkan Han & Harada kernel. The struct declarations below are
-// valid in both languages (C++ gets GLSL-named stand-ins for uint, vec4 and mat4); every
-// member is 4 or 16 bytes and vec4/mat4 sit at 16-byte offsets, so std430 and the C++
-// layout agree byte for byte (checked by static_asserts in models/han2012/vulkan/model.cpp).
+// Shared by C++ (models/han2012/vulkan/) and GLSL (han_step.comp, follow_hairs.comp): workgroup
+// sizes and the buffer layouts of the Vulkan Han & Harada kernel and of the follow hairs
+// built from its guides. The struct declarations below are
+// valid in both languages (C++ gets GLSL-named stand-ins for uint, vec3, vec4 and mat4);
+// every member is 4 or 16 bytes, or a vec3 followed by a 4-byte member, and vec3/vec4/mat4
+// sit at 16-byte offsets, so std430 and the C++ layout agree byte for byte (checked by
+// static_asserts in models/han2012/vulkan/model.cpp).
 #ifndef HAIRBENCH_KERNELS_VULKAN_HAN_LAYOUT_H
 #define HAIRBENCH_KERNELS_VULKAN_HAN_LAYOUT_H
 
@@ -32,12 +34,21 @@
 #define HAN_VK_BIND_SPHERES 9      // vec4 (centre, radius) [substep * colliders + c], world space
 #define HAN_VK_BINDINGS 10
 
+// The follow hairs kernel (follow_hairs.comp), its own descriptor set. The position
+// buffer is the step kernel's: the guides' vertices, then the follow strands' (in
+// FollowHairs order), so that one readback brings the whole groom.
+#define HAN_VK_FOLLOW_BIND_POS 0      // vec4 per vertex: reads the guides, writes the follow vertices
+#define HAN_VK_FOLLOW_BIND_STRANDS 1  // HanFollowStrand per follow strand
+#define HAN_VK_FOLLOW_BIND_VERTICES 2  // HanFollowVertex per follow vertex
+#define HAN_VK_FOLLOW_BINDINGS 3
+
 // Quaternions are vec4 (x, y, z, w): Eigen's coefficient order.
 
 #ifdef __cplusplus
 #include <cstdint>
 namespace hairbench::vk_layout {
 using uint = std::uint32_t;
+struct vec3 { float x, y, z; };
 struct vec4 { float x, y, z, w; };
 struct mat4 { float m[16]; };  // column-major, as GLSL and Eigen store it
 #endif
@@ -76,6 +87,23 @@ struct HanFrame {
 struct HanSubstep {
   mat4 head;           // head rest -> world
   vec4 head_rotation;  // wR_H as a quaternion
+};
+
+// One follow strand: its guide's vertices [guide_begin, guide_begin + count), the anchor
+// vertex (a guide vertex) that orients the guide's root normal, and the index of its
+// first vertex among the follow vertices.
+struct HanFollowStrand {
+  uint guide_begin;
+  uint count;
+  uint anchor;
+  uint first;
+};
+
+// One follow vertex: its offset from the guide vertex, (tangent, normal, binormal)
+// components in the guide's root frame, and its follow strand.
+struct HanFollowVertex {
+  vec3 offset;
+  uint strand;
 };
 
 #ifdef __cplusplus

@@ -3,47 +3,81 @@
 // one workgroup per strand or several short strands per workgroup, each strand in shared
 // memory for all substeps (§5). Rest data goes up once in reset(); per frame only the
 // head transforms, colliders, wind and gravity; positions come back only when asked for.
+// With follow hairs (TressFX), a second dispatch in the same submission builds them from
+// the guides' device positions.
 #pragma once
 
 #include "core/hair_model.h"
+#include "kernels/han2012/vulkan/han_layout.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han2012/reference/model.h"
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace hairbench::han_vk {
+
+// TressFX follow hairs laid out on the guides, as scenarios/tfx's FollowHairs holds them
+// (tfx.h; the same fields, viewed).
+struct FollowHairsView {
+  std::span<const std::uint32_t> guide_offsets;   // the guides' strand offsets
+  std::span<const std::uint32_t> guide;           // per follow strand: its guide strand
+  std::span<const std::uint32_t> anchor;          // per follow strand: the guide vertex orienting its root frame
+  std::span<const std::uint32_t> follow_offsets;  // follow strand f: offsets [follow_offsets[f], [f + 1])
+  std::span<const Vec3f> offsets;                 // per follow vertex: (tangent, normal, binormal) offset
+};
 
 class HanVkModel final : public HairModel {
  public:
   // Opens (or shares) the Vulkan context of ctx.device; throws vk::Unavailable when
   // there is no Vulkan device.
   HanVkModel(han::Method method, const ModelContext& ctx);
+  // Builds these follow hairs on the device after every step, from the guides' device
+  // positions (apply_follow_hairs's formula, in float); call before reset(), which then
+  // takes the guides expanded by the follow hairs (tfx::expand_follow_hairs) and
+  // simulates the guides only. Throws std::invalid_argument for an inconsistent layout.
+  void set_follow_hairs(const FollowHairsView& follow);
   // Throws InputError for a strand longer than HAN_VK_MAX_STRAND_VERTICES.
   void reset(const Groom& rest, const ParamSet& params) override;
-  // Uploads the frame's inputs, runs the dispatch and waits for it (stages "upload",
-  // "dispatch"; the device time of the dispatch is last_gpu_ms()).
+  // Uploads the frame's inputs, runs the dispatches and waits for them (stages "upload",
+  // "dispatch"; their device time is last_gpu_ms()).
   void step(const FrameInput& in, StageTimes& out_times) override;
-  // Reads the positions back on the first call after a step.
+  // Runs the step with `in` back to back for `seconds` (twice at least) and puts the state
+  // back as it was, on the device.
+  void warm_up(const FrameInput& in, double seconds) override;
+  // Reads the positions (the follow hairs' too) back on the first call after a step.
   std::span<const Vec4f> positions() const override;
   Backend backend() const override { return {"vulkan", context_->device().name}; }
   std::optional<double> last_gpu_ms() const override { return gpu_ms_; }
+  // Device time of the last step's follow hairs dispatch; nullopt without follow hairs.
+  std::optional<double> last_follow_gpu_ms() const { return follow_gpu_ms_; }
 
   // Invocations per strand the kernel uses for this groom (a power of two).
   std::uint32_t lanes() const { return lanes_; }
 
  private:
+  void upload_frame(const FrameInput& in);
+
   han::Method method_;
   std::shared_ptr<vk::Context> context_;
-  std::unique_ptr<vk::Kernel> kernel_;
+  std::unique_ptr<vk::Kernel> kernel_, follow_kernel_;
+  std::unique_ptr<vk::Commands> commands_;
   std::unique_ptr<vk::Readback> readback_;  // pos_ to host_pos_
   vk::Buffer pos_, prev_, rot_, rest_, rest_local_, rest_rot_, strands_, regions_, frame_, spheres_;
+  vk::Buffer follow_strands_, follow_vertices_;
+  // The follow hairs in the device's layout (han_layout.h), and the guides' strand
+  // offsets they were made for; empty without follow hairs.
+  std::vector<vk_layout::HanFollowStrand> follow_strands_host_;
+  std::vector<vk_layout::HanFollowVertex> follow_vertices_host_;
+  std::vector<std::uint32_t> follow_guide_offsets_;
   std::size_t strand_count_ = 0;
   std::uint32_t lanes_ = 1;
   std::uint32_t max_iterations_ = 0;
   int substeps_ = 1;
-  std::optional<double> gpu_ms_;
+  std::optional<double> gpu_ms_, follow_gpu_ms_;
   mutable std::vector<Vec4f> host_pos_;
   mutable bool host_current_ = true;
 };
