@@ -1,11 +1,14 @@
 // Properties Han & Harada 2012 claims for methods 1-3, checked on the built-in scenarios.
 #include "test_support.h"
 
+#include "kernels/han2012/reference/han_kernels.h"
 #include "scenarios/groom_gen.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 namespace hairbench {
 namespace {
@@ -118,6 +121,87 @@ TEST(HanMethods, Method2OnCurlyGroom) {
       EXPECT_LE(test::mean_of(m2.jaggedness), test::mean_of(m3.jaggedness)) << at;
     }
   }
+}
+
+// A rest edge of 2.4e-7 m on a strand of 5 mm edges 1 m from the origin, where floats are
+// 1.2e-7 m apart: one step of a coordinate turns it by 0.37 rad, so its direction is
+// rounding noise. Method 2 (Algorithm 4) keeps its frames as state, so a frame rebuilt
+// from that direction (lines 14-16) would carry the noise into the next iteration's
+// goals; the vertex takes its parent's frame composed with the rest relative rotation
+// ^{i-1}T_i^0 instead (= wR^0_{i-1}^-1 wR^0_i), and only there.
+TEST(HanMethods, Method2FrameAcrossARoundingSizedRestEdge) {
+  constexpr std::size_t n = 8, tiny = 4;
+  std::vector<Vec4f> rest(n);
+  Vec3f p(1.0f, 0.0f, 0.0f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float turn = 0.1f * static_cast<float>(i);  // a gentle curve in the x-y plane
+    const Vec3f dir(std::sin(turn), std::cos(turn), 0.0f);
+    if (i > 0) p += (i == tiny ? 2.4e-7f : 0.005f) * dir;
+    rest[i] = Vec4f(p.x(), p.y(), p.z(), i < 2 ? 0.0f : 1.0f);
+  }
+  std::vector<float> rest_length(n, 0.0f);
+  for (std::size_t i = 1; i < n; ++i) rest_length[i] = (rest[i] - rest[i - 1]).head<3>().norm();
+  std::vector<Quatf> rest_rotation(n), rest_relative(n);
+  std::vector<Vec3f> rest_local(n);
+  std::vector<std::uint8_t> rounding_sized(n);
+  kernels::init_rest_frames(rest, rest_rotation, rest_local);
+  kernels::init_rounding_sized_frames(rest_length, rest_local, rounding_sized, rest_relative);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(rounding_sized[i], i == tiny ? 1 : 0) << i;
+  EXPECT_LT(rest_relative[tiny].angularDistance(rest_rotation[tiny - 1].conjugate() * rest_rotation[tiny]), 1e-6f);
+
+  // The strand at rest but for one float step of x at the edge's end (across the edge),
+  // the frames at their rest state; one iteration of method 2 with S_L = 0.5.
+  auto iterate = [&](std::span<const std::uint8_t> flags) {
+    std::vector<Vec4f> pos = rest;
+    pos[tiny].x() = std::nextafter(pos[tiny].x(), 2.0f);
+    std::vector<Quatf> rotation = rest_rotation, scratch(n);
+    kernels::local_shape_m2(pos, rotation, scratch, rest_rotation, rest_local, flags, rest_relative,
+                            Quatf::Identity(), 0.5f);
+    return rotation;
+  };
+  const std::vector<Quatf> rotation = iterate(rounding_sized);
+  // parent · ^{i-1}T_i^0, normalised: with the parent at rest, the rest frame bit for bit.
+  EXPECT_TRUE(rotation[tiny].coeffs() == (rest_rotation[tiny - 1] * rest_relative[tiny]).normalized().coeffs());
+  EXPECT_TRUE(rotation[tiny].coeffs() == rest_rotation[tiny].coeffs());
+  // What the rule replaces: the frame from the edge, a third of a radian off.
+  const std::vector<std::uint8_t> none(n, 0);
+  const double noise = iterate(none)[tiny].angularDistance(rest_rotation[tiny]);
+  RecordProperty("frame_from_edge_rad", std::to_string(noise));
+  EXPECT_GT(noise, 0.1);
+}
+
+// Such edges in a whole groom (the gauntlet's case): the TressFX mohawk (2.6 mm median
+// edge, vertices 0.14-0.6 m from the origin), every 10th strand, with edge (17, 18) of
+// every 7th strand shrunk to 2.4e-7 m; head still, gravity on, 60 frames. Method 2
+// settles as on the groom without them: its kinetic energy falls e-fold faster than every
+// 0.1 s to under 1e-9 m^2/s^2 (-29/s to 8e-12 measured; with frames rebuilt from those
+// edges it grew, 2.1e-4 -> 3.4e-4), it sags to the same shape within 1e-5 L-bar (0.0033
+// L-bar from rest; 0.0099 with those frames), and the fused kernel keeps the reference's
+// bits.
+TEST(HanMethods, Method2AtRestAcrossRoundingSizedRestEdges) {
+  Scenario clean = builtin("tressfx_mohawk", 10);
+  clean.frames = 60;
+  clean.head = HeadMotion{};
+  clean.wind = WindScript{};
+  clean.settle_from = 0.0;
+  Scenario tiny = clean;
+  std::size_t shrunk = 0;
+  for (std::size_t s = 0; s < tiny.groom.strand_count(); s += 7, ++shrunk) {
+    Vec4f* v = tiny.groom.positions.data() + tiny.groom.strand_begin(s);
+    const Vec3f a = v[17].head<3>(), c = v[18].head<3>();
+    v[18].head<3>() = a + 2.4e-7f * (c - a).normalized();
+  }
+  ASSERT_GT(shrunk, 30u);
+  const auto clean_runs = test::run(clean, {"han_m2"});
+  const auto tiny_runs = test::run(tiny, {"han_m2", "han_m2_ref"});
+  const RunRecord& without = test::find(clean_runs, "han_m2");
+  const RunRecord& m2 = test::find(tiny_runs, "han_m2");
+  EXPECT_EQ(m2.verdict.status, verdict::Status::ok) << m2.verdict.reason;
+  RecordProperty("settle_rate", std::to_string(m2.verdict.settle.rate));
+  EXPECT_LT(m2.verdict.settle.rate, -10.0);
+  EXPECT_LT(m2.verdict.settle.energy_second, 1e-9);
+  EXPECT_NEAR(m2.rest_shape_error.back(), without.rest_shape_error.back(), 1e-5);
+  EXPECT_EQ(m2.state_hash, test::find(tiny_runs, "han_m2_ref").state_hash);
 }
 
 // §6: "method 1 shows the smoothest simulation result ... Method 3 shows some jagged

@@ -55,6 +55,16 @@ inline constexpr std::size_t block_floats(int method, int n) {
 // positions and inverse masses read from the float4 array).
 inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(10 * n) * kLanes; }
 
+// Method 2: a row with a rounding-sized rest edge in some lane (kernels::
+// init_rounding_sized_frames, reference/han_kernels.h). `on` is 1 in those lanes and 0 in the
+// others; there the frame is the parent's composed with the rest relative rotation
+// ^{i-1}T_i^0 (x, y, z, w) rather than rebuilt from the edge's direction, rounding noise.
+struct RoundingRow {
+  int row;  // the vertex i of edge (i-1, i)
+  float on[kLanes];
+  float qx[kLanes], qy[kLanes], qz[kLanes], qw[kLanes];
+};
+
 // What a row (one vertex of every lane) holds: free and pinned vertices need different
 // work, and most rows are all one or the other.
 enum RowKind : std::uint8_t { kRowFree, kRowPinned, kRowMixed };
@@ -68,6 +78,10 @@ struct Block {
   // without a strand of its own (kNoStrand out) reads the strand it repeats.
   const std::uint32_t* in_offset;
   const RowKind* rows;              // n entries
+  // Method 2: the rows with a rounding-sized rest edge in some lane, by row (none
+  // elsewhere, and in most blocks).
+  const RoundingRow* rounding_rows;
+  int rounding_row_count;
 };
 
 // Per-region solver settings, with the stages a region does not need switched off.

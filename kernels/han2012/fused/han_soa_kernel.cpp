@@ -531,10 +531,13 @@ void local_m1(const M1Block* blk, int n, const Substep& s, float stiffness) {
 // Method 2 (Algorithm 4, local_shape_m2): the frames are kept relative to the head and
 // composed with its rotation where used; goals and parents come from the previous
 // iteration's frames (copied to scratch), even/odd batches, each edge's frame rebuilt
-// right after that edge's constraint. Rows 0 and 1 of the frames hold the rest frames
-// of the pinned vertices from the start and are never written.
+// right after that edge's constraint, except where the rest edge is rounding-sized
+// (`rounding`, count rows): there the frame is the parent's composed with the rest
+// relative rotation. Rows 0 and 1 of the frames hold the rest frames of the pinned
+// vertices from the start and are never written.
 void local_m2(const Rows& r, int n, const float* lx, const float* ly, const float* lz, float* ow, float* ox, float* oy,
-              float* oz, float* scratch, const float* ka, const float* kb, const Substep& s, float stiffness) {
+              float* oz, float* scratch, const float* ka, const float* kb, const RoundingRow* rounding, int count,
+              const Substep& s, float stiffness) {
   if (n < 3) return;
   alignas(64) float hx[W], hy[W], hz[W], hw[W], gx[W], gy[W], gz[W];
   LANES {
@@ -578,6 +581,25 @@ void local_m2(const Rows& r, int n, const float* lx, const float* ly, const floa
         oz[b + l] = out.z[l];
       }
     }
+  // Rounding-sized rest edges: (parent · ^{i-1}T_i^0).normalized() from the previous
+  // iteration's parent. It reads no position, so writing it after both batches gives the
+  // bits the reference writes right after the edge's constraint.
+  for (int k = 0; k < count; ++k) {
+    const RoundingRow& e = rounding[k];
+    const int a = (e.row - 1) * W, b = e.row * W;
+    Quat m;
+    quat_mul(sx + a, sy + a, sz + a, sw + a, e.qx, e.qy, e.qz, e.qw, m);
+    LANES {
+      // Eigen's Quaternion::normalized(), as in child_frame.
+      const float n2 = (m.x[l] * m.x[l] + m.z[l] * m.z[l]) + (m.y[l] * m.y[l] + m.w[l] * m.w[l]);
+      const float rn = std::sqrt(n2);
+      const bool on = e.on[l] != 0.0f, scale = n2 > 0.0f;
+      ow[b + l] = on ? (scale ? m.w[l] / rn : m.w[l]) : ow[b + l];
+      ox[b + l] = on ? (scale ? m.x[l] / rn : m.x[l]) : ox[b + l];
+      oy[b + l] = on ? (scale ? m.y[l] / rn : m.y[l]) : oy[b + l];
+      oz[b + l] = on ? (scale ? m.z[l] / rn : m.z[l]) : oz[b + l];
+    }
+  }
 }
 
 // Edge length constraints (edge_length) in even/odd batches.
@@ -679,6 +701,8 @@ struct Ctx {
   float* d;
   float *scratch, *ka, *kb;
   const float* rest_frames;
+  const RoundingRow* rounding_rows;
+  int rounding_row_count;
   float* field(int k) const { return d + static_cast<std::size_t>(k) * rows; }
   std::size_t rows;
 };
@@ -704,6 +728,8 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
                sc + 4 * rows,
                sc + 5 * rows,
                method == 1 ? d + static_cast<std::size_t>(field_count(method)) * rows : nullptr,
+               blocks[j].rounding_rows,
+               blocks[j].rounding_row_count,
                rows};
     if (method == 1)
       m1[j] = M1Block{c[j].r, field(LX), field(LY), field(LZ), c[j].rest_frames, c[j].ka, c[j].kb};
@@ -777,7 +803,8 @@ void frame(const Block* blocks, int count, const BlockParams& p, const Frame& f,
           for (int j = 0; j < count; ++j) {
             const Ctx& b = c[j];
             local_m2(b.r, n, b.field(LX), b.field(LY), b.field(LZ), b.field(OW), b.field(OX), b.field(OY),
-                     b.field(OZ), b.scratch, b.ka, b.kb, s, p.local_stiffness);
+                     b.field(OZ), b.scratch, b.ka, b.kb, b.rounding_rows, b.rounding_row_count, s,
+                     p.local_stiffness);
           }
         }
         done(Stage::LocalShape);

@@ -2,6 +2,10 @@
 
 #include "kernels/han2012/frames.h"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 namespace hairbench::kernels {
 
 namespace {
@@ -30,6 +34,25 @@ void init_rest_frames(std::span<const Vec4f> rest, std::span<Quatf> rest_rotatio
     rest_local[i] = parent.conjugate() * edge;  // ^{i-1}P_i^0
     // Algorithm 2 line 8: ^{i-1}T_i^0 is the rotation from (1,0,0) to ^{i-1}x_i^0.
     rest_rotation[i] = (parent * rotation_from_x(rest_local[i].normalized())).normalized();
+  }
+}
+
+float rounding_sized_length(std::span<const float> rest_length) {
+  if (rest_length.size() < 2) return 0.0f;
+  std::vector<float> sorted(rest_length.begin() + 1, rest_length.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return kRoundingSizedEdge * sorted[sorted.size() / 2];
+}
+
+void init_rounding_sized_frames(std::span<const float> rest_length, std::span<const Vec3f> rest_local,
+                                std::span<std::uint8_t> rounding_sized, std::span<Quatf> rest_relative) {
+  std::fill(rounding_sized.begin(), rounding_sized.end(), std::uint8_t{0});
+  std::fill(rest_relative.begin(), rest_relative.end(), Quatf::Identity());
+  const float shortest = rounding_sized_length(rest_length);
+  for (std::size_t i = 1; i < rest_length.size(); ++i) {
+    if (!(rest_length[i] < shortest)) continue;
+    rounding_sized[i] = 1;
+    rest_relative[i] = rotation_from_x(rest_local[i].normalized());
   }
 }
 
@@ -62,6 +85,7 @@ void local_shape_m1(std::span<Vec4f> pos, std::span<const Quatf> rest_rotation,
 
 void local_shape_m2(std::span<Vec4f> pos, std::span<Quatf> rotation, std::span<Quatf> scratch,
                     std::span<const Quatf> rest_rotation, std::span<const Vec3f> rest_local,
+                    std::span<const std::uint8_t> rounding_sized, std::span<const Quatf> rest_relative,
                     const Quatf& head_rotation, float stiffness) {
   const std::size_t n = pos.size();
   if (n < 3) return;
@@ -74,13 +98,19 @@ void local_shape_m2(std::span<Vec4f> pos, std::span<Quatf> rotation, std::span<Q
   for (std::size_t i = 0; i < n; ++i) scratch[i] = rotation[i];
   // Lines 12-16 are one thread's work on vertex i: its constraint, then its frame from
   // the edge that constraint has just corrected, before the other batch (§5) moves the
-  // edge's ends again.
+  // edge's ends again. Line 14's ^{i-1}x_i is the direction of a rest edge that may be
+  // rounding-sized, and then it is rounding noise: read anew each iteration, the noise
+  // would persist in these frames (they are state, unlike method 1's, which are rebuilt
+  // from the root every iteration) and feed back through every goal below the edge. Such
+  // a vertex takes the rest relative rotation ^{i-1}T_i^0 instead, the frame its rest
+  // state says.
   for (std::size_t first : {std::size_t{2}, std::size_t{3}})
     for (std::size_t i = first; i < n; i += 2) {
       const Quatf parent = head_rotation * scratch[i - 1];
       const Vec3f goal = xyz(pos[i - 1]) + parent * rest_local[i];
       local_shape_edge(pos[i - 1], pos[i], goal, stiffness);
-      rotation[i] = child_frame(scratch[i - 1], parent, pos[i - 1], pos[i]);
+      rotation[i] = rounding_sized[i] ? (scratch[i - 1] * rest_relative[i]).normalized()
+                                      : child_frame(scratch[i - 1], parent, pos[i - 1], pos[i]);
     }
 }
 

@@ -8,6 +8,7 @@
 
 #include "core/types.h"
 
+#include <cstdint>
 #include <span>
 
 namespace hairbench::kernels {
@@ -22,6 +23,24 @@ void global_shape(std::span<Vec4f> pos, std::span<const Vec4f> rest, const Affin
 // position of vertex i in frame i-1, ^{i-1}P_i^0 (index 0 unused).
 void init_rest_frames(std::span<const Vec4f> rest, std::span<Quatf> rest_rotation,
                       std::span<Vec3f> rest_local);
+
+// A rest edge shorter than this fraction of its strand's median rest edge is
+// rounding-sized: its direction is mostly the float rounding of its end positions (an
+// edge of 2.4e-7 m 1 m from the origin, where a coordinate rounds by up to 6e-8 m, turns
+// by up to 0.24 rad when one coordinate of one end rounds).
+inline constexpr float kRoundingSizedEdge = 1e-3f;
+
+// One strand's rest edges (rest_length[i]: edge (i-1, i), index 0 unused) shorter than
+// this are rounding-sized: kRoundingSizedEdge times their median (0 without edges).
+float rounding_sized_length(std::span<const float> rest_length);
+
+// Method 2's frames across rounding-sized rest edges, one strand: rounding_sized[i] is 1
+// where edge (i-1, i) is shorter than rounding_sized_length, and there rest_relative[i]
+// is ^{i-1}T_i^0, the rotation from (1,0,0) to ^{i-1}x_i^0 (Algorithm 2 line 8, the bits
+// init_rest_frames composes: wR_i^0 = wR_{i-1}^0 · ^{i-1}T_i^0, normalised); 0 and the
+// identity elsewhere.
+void init_rounding_sized_frames(std::span<const float> rest_length, std::span<const Vec3f> rest_local,
+                                std::span<std::uint8_t> rounding_sized, std::span<Quatf> rest_relative);
 
 // The local shape constraint for edge (i-1, i) (Han & Harada Eq. 4): with
 // d = goal - P_i, P_{i-1} -= S_L d·w_{i-1}/(w_{i-1}+w_i) and P_i += S_L d·w_i/(...).
@@ -45,8 +64,12 @@ void local_shape_m1(std::span<Vec4f> pos, std::span<const Quatf> rest_rotation,
 // (§5), and each edge's frame is rebuilt from its parent's previous-iteration frame right
 // after that edge's constraint (lines 12-16, one thread's sequence). `rotation` persists
 // across iterations, substeps and frames: the transforms are simulation state (§5).
+// Where the rest edge is rounding-sized (init_rounding_sized_frames), the frame is the
+// parent's composed with the rest relative rotation rest_relative[i] instead of one
+// rebuilt from the edge's direction, which is rounding noise there.
 void local_shape_m2(std::span<Vec4f> pos, std::span<Quatf> rotation, std::span<Quatf> scratch,
                     std::span<const Quatf> rest_rotation, std::span<const Vec3f> rest_local,
+                    std::span<const std::uint8_t> rounding_sized, std::span<const Quatf> rest_relative,
                     const Quatf& head_rotation, float stiffness);
 
 // Method 3 (Algorithm 5): the rest-state frames under the head rotation, never updated:

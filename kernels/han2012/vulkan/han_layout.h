@@ -53,12 +53,13 @@ struct vec4 { float x, y, z, w; };
 struct mat4 { float m[16]; };  // column-major, as GLSL and Eigen store it
 #endif
 
-// One strand: its vertices [begin, begin + count) and its region.
+// One strand: its vertices [begin, begin + count), its region, and the length under
+// which its rest edges are rounding-sized (kernels::rounding_sized_length; method 2).
 struct HanStrand {
   uint begin;
   uint count;
   uint region;
-  uint pad;
+  float rounding_edge;
 };
 
 // Solver settings of one region (models/han2012/settings.h).

@@ -127,7 +127,7 @@ void main() {
   const uint lane = gl_LocalInvocationID.x % LANES;
   const uint s = gl_WorkGroupID.x * strands_per_group + slot;
   // Slots past the last strand have no vertices; they still reach every barrier.
-  HanStrand st = HanStrand(0u, 0u, 0u, 0u);
+  HanStrand st = HanStrand(0u, 0u, 0u, 0.0);
   if (s < frame.strands) st = g_strands[s];
   const uint n = st.count, b = st.begin;
   const uint base = slot * LANES * VPL;  // the strand's first vertex in shared memory
@@ -215,7 +215,10 @@ void main() {
         // frames. Goals and parents read the previous iteration's frames (wT_temp, line
         // 5), shared after a barrier (line 6); even then odd edges (§5); each invocation
         // rebuilds its vertex's frame right after its own constraint (lines 12-16),
-        // before the other batch moves the edge.
+        // before the other batch moves the edge. Where the rest edge is rounding-sized
+        // its direction is rounding noise, which the kept frames would feed back: the
+        // frame is the parent's composed with the rest relative rotation ^{i-1}T_i^0
+        // (Algorithm 2 line 8) instead, as kernels::local_shape_m2.
         for (uint k = 0u; k < VPL; ++k) {
           const uint i = lane + k * LANES;
           if (i >= n || !local) break;
@@ -231,7 +234,10 @@ void main() {
             const vec4 world = qmul(head_rotation, parent);
             const vec3 goal = s_pos[base + i - 1u].xyz + qrot(world, rest_local[k].xyz);
             local_shape_edge(base + i - 1u, base + i, goal, r.local_stiffness);
-            rot[k] = child_frame(parent, world, s_pos[base + i - 1u].xyz, s_pos[base + i].xyz);
+            if (rest_local[k].w < st.rounding_edge)
+              rot[k] = qnormalize(qmul(parent, rotation_from_x(normalize(rest_local[k].xyz))));
+            else
+              rot[k] = child_frame(parent, world, s_pos[base + i - 1u].xyz, s_pos[base + i].xyz);
           }
           sync();
         }

@@ -49,16 +49,24 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
   substeps_ = params.get_int("substeps");
 
-  // Rest frames (Algorithm 2) with the per-strand kernel, for methods 1 and 2.
-  std::vector<Quatf> rest_rotation;
+  // Rest frames (Algorithm 2) with the per-strand kernel, for methods 1 and 2, and
+  // method 2's frames across rounding-sized rest edges.
+  std::vector<Quatf> rest_rotation, rest_relative;
   std::vector<Vec3f> rest_local;
+  std::vector<std::uint8_t> rounding_sized;
   if (any_frames) {
     rest_rotation.assign(rest.vertex_count(), Quatf::Identity());
     rest_local.assign(rest.vertex_count(), Vec3f::Zero());
+    rest_relative.assign(rest.vertex_count(), Quatf::Identity());
+    rounding_sized.assign(rest.vertex_count(), 0);
     for (std::size_t s = 0; s < rest.strand_count(); ++s) {
       const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
       kernels::init_rest_frames(std::span(rest.positions).subspan(b, n), std::span(rest_rotation).subspan(b, n),
                                 std::span(rest_local).subspan(b, n));
+      kernels::init_rounding_sized_frames(std::span(rest_length).subspan(b, n),
+                                          std::span<const Vec3f>(rest_local).subspan(b, n),
+                                          std::span(rounding_sized).subspan(b, n),
+                                          std::span(rest_relative).subspan(b, n));
     }
   }
 
@@ -102,6 +110,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
 
   data_.assign(floats, 0.0f);
   row_kinds_.clear();
+  rounding_rows_.clear();
   int max_n = 0;
   any_global_ = any_local_ = any_length_ = false;
   for (std::size_t k = 0; k < blocks_.size(); ++k) {
@@ -120,6 +129,26 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
       for (int l = 0; l < W; ++l) pinned += rest.positions[rest.strand_begin(lanes[k][l]) + i].w() == 0.0f;
       row_kinds_.push_back(pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed);
     }
+    // Method 2's rows with a rounding-sized rest edge in some lane (local_shape_m2 reads
+    // vertices 2 and up).
+    blocks_[k].rounding_first = rounding_rows_.size();
+    for (int i = 2; b.method == 2 && i < b.n; ++i) {
+      soa::RoundingRow e{};
+      e.row = i;
+      bool any = false;
+      for (int l = 0; l < W; ++l) {
+        const std::size_t v = rest.strand_begin(lanes[k][l]) + static_cast<std::size_t>(i);
+        const Quatf& q = rest_relative[v];
+        any = any || rounding_sized[v] != 0;
+        e.on[l] = rounding_sized[v] != 0 ? 1.0f : 0.0f;
+        e.qx[l] = q.x();
+        e.qy[l] = q.y();
+        e.qz[l] = q.z();
+        e.qw[l] = q.w();
+      }
+      if (any) rounding_rows_.push_back(e);
+    }
+    blocks_[k].rounding_count = static_cast<int>(rounding_rows_.size() - b.rounding_first);
     for (int l = 0; l < W; ++l) {
       const std::size_t v0 = rest.strand_begin(lanes[k][l]);
       for (int i = 0; i < b.n; ++i) {
@@ -200,7 +229,7 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
 }
 
 std::size_t HanFusedModel::state_bytes() const {
-  return data_.size() * sizeof(float) + pos_.size() * sizeof(Vec4f);
+  return data_.size() * sizeof(float) + pos_.size() * sizeof(Vec4f) + rounding_rows_.size() * sizeof(soa::RoundingRow);
 }
 
 // The next job's blocks and output lines, for the kernel to request while this job
@@ -237,7 +266,7 @@ void HanFusedModel::run_thread(int t) {
     for (int i = 0; i < job.count; ++i) {
       const BlockInfo& b = blocks_[job.first + static_cast<std::size_t>(i)];
       blocks[i] = {data_.data() + b.offset, b.n, b.method, b.out_offset.data(), b.in_offset.data(),
-                   row_kinds_.data() + b.row_kinds};
+                   row_kinds_.data() + b.row_kinds, rounding_rows_.data() + b.rounding_first, b.rounding_count};
       if (!calm_) continue;
       for (std::uint32_t s : b.strand)
         if (s != soa::kNoStrand) {

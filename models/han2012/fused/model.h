@@ -46,6 +46,8 @@ class HanFusedModel final : public HairModel {
   struct BlockInfo {
     std::size_t offset;  // into data_
     std::size_t row_kinds;  // into row_kinds_
+    std::size_t rounding_first;  // into rounding_rows_, rounding_count of them (method 2)
+    int rounding_count;
     int n, method;
     std::uint16_t region;
     std::array<std::uint32_t, kernels::han_soa::kLanes> out_offset;
@@ -74,6 +76,7 @@ class HanFusedModel final : public HairModel {
   std::size_t scratch_stride_ = 0;
   std::vector<ThreadState> threads_;
   std::vector<kernels::han_soa::RowKind> row_kinds_;
+  std::vector<kernels::han_soa::RoundingRow> rounding_rows_;
   std::vector<Vec4f> pos_;
   int substeps_ = 1;
   bool any_global_ = false, any_local_ = false, any_length_ = false;

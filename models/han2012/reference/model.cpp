@@ -19,10 +19,15 @@ void HanModel::reset(const Groom& rest, const ParamSet& params) {
   prev_ = rest.positions;
   rest_rotation_.assign(rest.vertex_count(), Quatf::Identity());
   rest_local_.assign(rest.vertex_count(), Vec3f::Zero());
+  rounding_sized_.assign(rest.vertex_count(), 0);
+  rest_relative_.assign(rest.vertex_count(), Quatf::Identity());
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
     const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
     k::init_rest_frames(std::span(rest.positions).subspan(b, n),
                         std::span(rest_rotation_).subspan(b, n), std::span(rest_local_).subspan(b, n));
+    k::init_rounding_sized_frames(std::span<const float>(rest_length_).subspan(b, n),
+                                  std::span<const Vec3f>(rest_local_).subspan(b, n),
+                                  std::span(rounding_sized_).subspan(b, n), std::span(rest_relative_).subspan(b, n));
   }
   rotation_ = rest_rotation_;
   scratch_ = rest_rotation_;
@@ -128,7 +133,9 @@ void HanModel::substep(const Affine3f& head, const FrameInput& in, const FramePl
             break;
           case Method::Jacobi:
             k::local_shape_m2(strand(pos_, s), std::span(rotation_).subspan(b, n),
-                              std::span(scratch_).subspan(b, n), rest_rot, rest_loc, head_rotation,
+                              std::span(scratch_).subspan(b, n), rest_rot, rest_loc,
+                              std::span<const std::uint8_t>(rounding_sized_).subspan(b, n),
+                              std::span<const Quatf>(rest_relative_).subspan(b, n), head_rotation,
                               r.local_stiffness);
             break;
           case Method::RestFrames:

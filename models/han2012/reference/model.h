@@ -6,6 +6,7 @@
 #include "core/hair_model.h"
 #include "core/sleep.h"
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -27,8 +28,8 @@ class HanModel final : public HairModel {
   std::size_t state_bytes() const override {
     return (pos_.size() + prev_.size() + rest_.positions.size()) * sizeof(Vec4f) +
            rest_length_.size() * sizeof(float) +
-           (rest_rotation_.size() + rotation_.size() + scratch_.size()) * sizeof(Quatf) +
-           rest_local_.size() * sizeof(Vec3f);
+           (rest_rotation_.size() + rotation_.size() + scratch_.size() + rest_relative_.size()) * sizeof(Quatf) +
+           rest_local_.size() * sizeof(Vec3f) + rounding_sized_.size();
   }
 
  private:
@@ -52,6 +53,10 @@ class HanModel final : public HairModel {
   std::vector<float> rest_length_;
   std::vector<Quatf> rest_rotation_;  // wR_i^0 (Algorithm 2)
   std::vector<Vec3f> rest_local_;     // ^{i-1}P_i^0
+  // Method 2: whether rest edge (i-1, i) is rounding-sized, and there ^{i-1}T_i^0
+  // (kernels::init_rounding_sized_frames).
+  std::vector<std::uint8_t> rounding_sized_;
+  std::vector<Quatf> rest_relative_;
   std::vector<RegionSettings> region_;
   int substeps_ = 1;
   int max_iterations_ = 0;

@@ -152,11 +152,12 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
                        std::to_string(HAN_VK_GROUP_SIZE) + " invocations x " +
                        std::to_string(HAN_VK_VERTICES_PER_LANE) + ")");
     longest = std::max(longest, n);
-    strands[s] = {rest.strand_begin(s), n, rest.strand_region[s], 0};
   }
   lanes_ = lanes_override(longest).value_or(choose_lanes(method_, longest, strand_count_));
 
-  // Rest frames and lengths exactly as the CPU model computes them (Algorithm 2).
+  // Rest frames and lengths exactly as the CPU model computes them (Algorithm 2), and
+  // each strand's length under which a rest edge is rounding-sized (method 2 takes the
+  // frame across such an edge from the rest state, kernels::local_shape_m2).
   const std::vector<float> rest_length = rest_edge_lengths(rest);
   std::vector<Quatf> rest_rotation(nv, Quatf::Identity());
   std::vector<Vec3f> rest_local(nv, Vec3f::Zero());
@@ -164,6 +165,8 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
     const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
     kernels::init_rest_frames(std::span(rest.positions).subspan(b, n), std::span(rest_rotation).subspan(b, n),
                               std::span(rest_local).subspan(b, n));
+    strands[s] = {rest.strand_begin(s), rest.strand_size(s), rest.strand_region[s],
+                  kernels::rounding_sized_length(std::span(rest_length).subspan(b, n))};
   }
   std::vector<L::vec4> local(nv), rot(nv);
   for (std::size_t i = 0; i < nv; ++i) {
