@@ -10,7 +10,8 @@
 #include "models/han2012/fused/model.h"
 #include "models/han2012/reference/model.h"
 #include "models/han2012/settings.h"
-#include "models/plante2001/model.h"
+#include "models/plante2001/fused/model.h"
+#include "models/plante2001/reference/model.h"
 #include "models/plante2001/settings.h"
 #ifdef HAIRBENCH_HAS_VULKAN
 #include "models/han2012/vulkan/model.h"
@@ -89,7 +90,7 @@ std::span<const ModelInfo> model_registry() {
       {.name = "plante_wisp_ref",
        .summary = "plante_wisp one stage at a time over all wisps with the per-wisp kernels",
        .params = plante::kParams,
-       .make = [](const ModelContext& c) { return plante::make_plante_wisp(c, plante::Schedule::PerStage); },
+       .make = [](const ModelContext& c) { return plante::make_plante_wisp_ref(c); },
        .reference_of = "plante_wisp"},
 #ifdef HAIRBENCH_HAS_VULKAN
       {.name = "han_m1_vk",

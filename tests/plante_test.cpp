@@ -4,7 +4,8 @@
 #include "kernels/simd/vec_math.h"
 #include "kernels/plante2001/wisp_grid.h"
 #include "kernels/plante2001/fused/wisp_soa.h"
-#include "models/plante2001/model.h"
+#include "models/plante2001/fused/model.h"
+#include "models/plante2001/reference/model.h"
 #include "models/plante2001/settings.h"
 #include "reports/metrics.h"
 #include "reports/verdict.h"
@@ -38,7 +39,7 @@ void add_line(Groom& g, const Vec3f& start, const Vec3f& step, int n) {
 // Steps a model `frames` frames of length dt with the head still, no gravity, no
 // colliders; calls check(frame) after each.
 template <class F>
-void run_still(plante::PlanteWispModel& m, int frames, F&& check, double dt = 1.0 / 60.0) {
+void run_still(plante::WispModel& m, int frames, F&& check, double dt = 1.0 / 60.0) {
   StageTimes times;
   for (int f = 0; f < frames; ++f) {
     FrameInput in;
@@ -61,7 +62,7 @@ struct Crossing {
   }
 };
 
-double crossing_gap(const plante::PlanteWispModel& m) {
+double crossing_gap(const plante::WispModel& m) {
   const auto& s = m.wisps();
   const std::uint32_t a5 = s.node_begin[m.strand_wisp()[0]] + 5, b5 = s.node_begin[m.strand_wisp()[1]] + 5;
   return s.x[b5].z() - s.x[a5].z();
@@ -286,7 +287,8 @@ TEST(PlanteWisp, TipPinnedWispKeepsItsLastSegmentDirection) {
 TEST(PlanteWisp, TipPinnedWispsInABlockAgreeWithTheReference) {
   const Groom g = tip_pinned_curls(16);
   const ParamSet params = plante_params(g, {{"strands_per_wisp", 1}});
-  plante::PlanteWispModel fast(ModelContext{nullptr}), ref(ModelContext{nullptr}, plante::Schedule::PerStage);
+  plante::PlanteWispModel fast(ModelContext{nullptr});
+  plante::PlanteWispRef ref(ModelContext{nullptr});
   fast.reset(g, params);
   ref.reset(g, params);
   ASSERT_EQ(fast.block_wisps(), 16u) << "the curls do not run as one block: the test would not reach its lanes";
@@ -584,8 +586,8 @@ TEST(PlanteWisp, BodyBlockKernelsAgreeWhereMassesStartInside) {
   ASSERT_FALSE(sc.colliders.empty());
   sc.colliders[0].radius += 0.005f;
   const ParamSet params = plante_params(sc.groom);
-  plante::PlanteWispModel fast(ModelContext{nullptr}, plante::Schedule::Fused);
-  plante::PlanteWispModel ref(ModelContext{nullptr}, plante::Schedule::PerStage);
+  plante::PlanteWispModel fast(ModelContext{nullptr});
+  plante::PlanteWispRef ref(ModelContext{nullptr});
   fast.reset(sc.groom, params);
   ref.reset(sc.groom, params);
   ASSERT_GT(fast.block_wisps(), 0u);

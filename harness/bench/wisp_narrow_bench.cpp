@@ -12,7 +12,7 @@
 #include "kernels/simd/isa.h"
 #include "kernels/plante2001/wisp_grid.h"
 #include "kernels/plante2001/fused/wisp_soa.h"
-#include "models/plante2001/model.h"
+#include "models/plante2001/fused/model.h"
 #include "models/registry.h"
 #include "scenarios/scenario.h"
 
@@ -38,7 +38,7 @@ const kernels::WispSystem& shaken_wisps() {
     std::unique_ptr<HairModel> model = make_model(*info, sc, resolve_params(*info, sc, {}), pool);
     StageTimes times;
     for (int f = 0; f < kFrames && f < sc.frames; ++f) model->step(frame_input(sc, f), times);
-    return dynamic_cast<const plante::PlanteWispModel&>(*model).wisps();
+    return dynamic_cast<const plante::WispModel&>(*model).wisps();
   }();
   return wisps;
 }

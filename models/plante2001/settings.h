@@ -8,7 +8,7 @@
 // interaction off. The wisp-wisp contacts a detection finds get their velocity
 // modifications (§5.1 step 3) in that step, their drag standing for the detection
 // period; a body contact is a sliding contact until the next body detection and is
-// modified on every step in between (models/plante2001/model.cpp).
+// modified on every step in between (models/plante2001/wisp_model.cpp).
 //
 // Masses are the hair a node carries, in strand-metres (kernels/plante2001/reference/wisp_kernels.h):
 // half of each adjacent segment's, the length of the wisp's strands along it. A

@@ -7,10 +7,10 @@
 #pragma once
 
 #include "core/hair_model.h"
+#include "core/parallel.h"
 #include "core/sleep.h"
 #include "kernels/plante2001/wisp_grid.h"
 #include "kernels/plante2001/reference/wisp_kernels.h"
-#include "kernels/plante2001/fused/wisp_soa.h"
 
 #include <array>
 #include <atomic>
@@ -21,15 +21,13 @@
 
 namespace hairbench::plante {
 
-// How a step visits the wisps. Fused: each wisp goes through all of a step's stages in
-// one pass while it is in cache (plante_wisp). PerStage: one pass over all wisps per
-// stage (plante_wisp_ref, the reference); both run the same kernels in the same order
-// per wisp, so their results are bit-identical.
-enum class Schedule { Fused, PerStage };
-
-class PlanteWispModel final : public HairModel {
+// What the reference (reference/model.h, plante_wisp_ref) and the fused schedule
+// (fused/model.h, plante_wisp) share: the wisps built from the groom, the loop of §5.1 at
+// the rates of §5.3, the wisp-wisp detection's grid and chunks, and the strands' rebuild.
+// The two differ only in how a step visits the wisps (the hooks below); both run the same
+// kernels in the same order per wisp, so their results are bit-identical.
+class WispModel : public HairModel {
  public:
-  explicit PlanteWispModel(const ModelContext& ctx, Schedule schedule = Schedule::Fused);
   void reset(const Groom& rest, const ParamSet& params) override;
   // Stages: integrate, body_collision, self_interaction, rebuild.
   void step(const FrameInput& in, StageTimes& out_times) override;
@@ -51,38 +49,49 @@ class PlanteWispModel final : public HairModel {
   void rebuild(const Affine3f& head);
   // Contacts of the last wisp-wisp detection.
   std::span<const kernels::WispContact> contacts() const { return contacts_; }
-  // The block and narrow-phase kernels' ISA variant (by default this CPU's best), for the
-  // tests that compare variants; and how many wisps the block kernels take.
-  void use_kernels(const kernels::wisp_soa::Kernels& k) { block_ = k; }
-  std::size_t block_wisps() const;
 
- private:
+ protected:
+  explicit WispModel(const ModelContext& ctx);
+
+  // One integration step's inputs (§5.1), for integrate().
+  struct StepInput {
+    const FrameInput& in;
+    Affine3f head;
+    Eigen::Matrix3f head_rot;
+    float h;                       // the integration step, s
+    const kernels::BodyStep& body;
+    float drag;                    // the bodies' viscous friction over this step
+    bool body_on;                  // sliding contacts are modified on this step
+    bool body_due;                 // and body contacts detected
+    bool interact;                 // wisp-wisp interactions detected and responded to
+  };
+  // The hooks each schedule implements:
+  // after reset's clustering, with the number of threads;
+  virtual void prepare(std::size_t threads) = 0;
+  // §5.1 (1)-(4) for one integration step: forces, the wisp-wisp interactions when
+  // s.interact (detect_self_interactions and their response), velocities, positions and
+  // the bodies' modifications, timed as the stages;
+  virtual void integrate(const StepInput& s, StageTimes& times) = 0;
+  // the detection grid's cells, after its segments are set up;
+  virtual void build_cells(std::size_t threads) = 0;
+  // the narrow phase of segments [begin, end) on thread `thread`, after
+  // begin_narrow_phase(thread, segments) for each thread of a detection;
+  virtual void begin_narrow_phase(std::size_t thread, std::size_t segments) = 0;
+  virtual void narrow_phase(std::size_t thread, std::size_t begin, std::size_t end,
+                            std::vector<kernels::WispContact>& out) = 0;
+  // the rebuild's section points and weights of strand s (strand_points_,
+  // strand_weights_), after prepare_sections once per rebuild.
+  virtual void prepare_sections(const Eigen::Matrix3f& head_rot) = 0;
+  virtual void section_points(std::size_t strand, const Eigen::Matrix3f& head_rot) = 0;
+
   void cluster(const Groom& rest, int wisps, int strands_per_wisp, int segments, int root_blend, float width_max,
                float r_min);
-  // The stages a fused pass over the wisps times (see wisp_pass).
-  enum PassStage { kIntegration = 0, kBody = 1 };
-  struct WispClock {
-    bool on = false;
-    std::chrono::steady_clock::time_point last;
-    std::array<std::atomic<std::int64_t>*, 2> sampled_ns{};
-    void lap(int stage);  // time since the last lap to `stage`, on sampled wisps
-  };
   // f(begin, end) over [0, count), split statically over the threads.
   template <class F>
   void for_each(std::size_t count, F&& f);
-  // f(run, clock) for every run of wisps (runs_), over the threads; adds the pass's
-  // time to the stages.
-  template <class F>
-  void wisp_pass(StageTimes& times, F&& f);
-  // f(w) for every wisp, over the threads, timed as `stage` (the per-stage schedule).
-  template <class F>
-  void stage_pass(StageTimes& times, Stage stage, F&& f);
   void detect_self_interactions();
-  // k::wisp_contacts_respond over the threads, for the contacts of the last detection.
-  void respond_to_contacts(float h);
 
   ModelContext ctx_;
-  Schedule schedule_;
   Groom rest_;
   std::vector<kernels::WispParams> params_;  // per groom region
   kernels::InteractionParams interaction_;
@@ -93,26 +102,11 @@ class PlanteWispModel final : public HairModel {
   StrandSleep sleep_;
 
   kernels::WispSystem sys_;
-  // The fused schedule's units of work, in wisp order: blocks of up to wisp_soa::kLanes
-  // consecutive wisps that the block kernels take together (one node count and one
-  // params set each), and single wisps.
-  struct WispRun {
-    std::uint32_t first, count;
-  };
-  std::vector<WispRun> runs_;
-  std::vector<std::size_t> run_bounds_;  // thread t's runs: [run_bounds_[t], run_bounds_[t + 1])
-  // During a pass, the runs of thread t's range not yet taken (wisp_pass).
-  struct alignas(64) RunRange {
-    std::atomic<std::uint64_t> range{0};
-  };
-  std::vector<RunRange> run_ranges_;
-  kernels::wisp_soa::Kernels block_ = kernels::wisp_soa::kernels();  // and the narrow phase
   std::vector<std::uint32_t> strand_wisp_;
   std::vector<Vec4f> coord_;              // per groom vertex
   std::vector<std::uint32_t> vertex_node_;  // per groom vertex: the node coord_ is relative to
   std::vector<Vec4f> pos_;
-  // The rebuild's (plante_wisp): per node, and each vertex's section point and weight.
-  std::vector<kernels::NodeSection> node_sections_;
+  // The rebuild's section point and weight of each vertex (section_points).
   std::vector<Vec3f> strand_points_;
   std::vector<float> strand_weights_;
 
@@ -121,18 +115,21 @@ class PlanteWispModel final : public HairModel {
   static constexpr std::size_t kChunksPerThread = 8;
   std::vector<std::vector<kernels::WispContact>> chunk_contacts_;
   std::vector<std::size_t> chunk_bounds_, chunk_offset_;
-  std::vector<std::vector<std::uint32_t>> thread_mailbox_;
+  std::size_t threads_ = 1;  // of the pool, or 1
   std::vector<kernels::WispContact> contacts_;
-  std::vector<kernels::ContactImpulse> impulses_;  // per contact (respond_to_contacts)
-  std::vector<kernels::wisp_soa::ContactNode> contact_nodes_;  // per node, the impulses' input rows
-  // Thread t sums the contacts on nodes [node_bounds_[t], node_bounds_[t + 1]) (respond_to_contacts).
-  std::vector<std::uint32_t> node_bounds_;
   bool contacts_known_ = false;  // a body detection has run since reset
   std::vector<Vec4f> spheres_;
   std::vector<std::int32_t> sphere_moves_;
-  std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};
 };
 
-std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx, Schedule schedule = Schedule::Fused);
+template <class F>
+void WispModel::for_each(std::size_t count, F&& f) {
+  // Static partition (ThreadPool::parallel_for); every caller's results are the same
+  // whichever thread runs which range. Below threads_min_wisps wisps, one thread.
+  if (ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
+    ctx_.pool->parallel_for(count, [&](std::size_t begin, std::size_t end) { f(begin, end); });
+  else
+    f(std::size_t{0}, count);
+}
 
 }  // namespace hairbench::plante

@@ -1,4 +1,4 @@
-#include "models/plante2001/model.h"
+#include "models/plante2001/wisp_model.h"
 
 #include "core/parallel.h"
 #include "models/plante2001/settings.h"
@@ -14,7 +14,7 @@ namespace hairbench::plante {
 
 namespace k = hairbench::kernels;
 
-PlanteWispModel::PlanteWispModel(const ModelContext& ctx, Schedule schedule) : ctx_(ctx), schedule_(schedule) {}
+WispModel::WispModel(const ModelContext& ctx) : ctx_(ctx) {}
 
 namespace {
 
@@ -359,7 +359,7 @@ Skeleton skeleton_of(const Groom& g, const std::vector<std::uint32_t>& c, int se
 
 }  // namespace
 
-void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int segments, int root_blend,
+void WispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp, int segments, int root_blend,
                               float width_max, float r_min) {
   // Wisps only gather strands of one region (they share its parameters) and of one
   // vertex count (their vertices share the mean curve the skeleton is laid along).
@@ -440,7 +440,7 @@ void PlanteWispModel::cluster(const Groom& rest, int wisps, int strands_per_wisp
   }
 }
 
-void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
+void WispModel::reset(const Groom& rest, const ParamSet& params) {
   rest_ = rest;
   sleep_.reset(1);
   params_.clear();
@@ -476,178 +476,31 @@ void PlanteWispModel::reset(const Groom& rest, const ParamSet& params) {
           params.get_int("root_blend"), static_cast<float>(params.get("wisp_width_max")), r_min);
   for (float& r : sys_.r_rest) r = std::max(r, r_min);
   for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
-  // Blocks of the fused schedule: consecutive wisps of one node count and params set
-  // (k-means clusters of one region and strand size are consecutive, cluster()). A block
-  // costs about as much as 7 wisps through the per-wisp kernels whatever its lanes in
-  // use, so it takes runs of at least half its lanes.
-  runs_.clear();
-  constexpr std::uint32_t lanes = k::wisp_soa::kLanes, kMinBlockLanes = lanes / 2;
-  const auto wisps = static_cast<std::uint32_t>(sys_.wisp_count());
-  auto size = [&](std::uint32_t w) { return sys_.node_begin[w + 1] - sys_.node_begin[w]; };
-  for (std::uint32_t w = 0; w < wisps;) {
-    std::uint32_t n = 0;
-    while (n < lanes && w + n < wisps && k::wisp_soa::block_eligible(sys_, w + n) && size(w + n) == size(w) &&
-           sys_.wisp_params[w + n] == sys_.wisp_params[w])
-      ++n;
-    if (n < kMinBlockLanes) n = 1;
-    runs_.push_back({w, n});
-    w += n;
-  }
-
   const std::size_t threads = ctx_.pool ? static_cast<std::size_t>(ctx_.pool->threads()) : 1;
-  // The threads' shares of the runs, of about equal cost rather than equal counts: a
-  // wisp through the per-wisp kernels costs about a seventh of a block (above), and such
-  // wisps gather where the groom has them (where they lie mostly at the end of the list,
-  // equal counts of runs would leave most of the integration to one thread).
-  constexpr std::uint64_t kBlockCost = 7;
-  std::vector<std::uint64_t> cost_before(runs_.size() + 1, 0);
-  for (std::size_t i = 0; i < runs_.size(); ++i)
-    cost_before[i + 1] = cost_before[i] + (runs_[i].count > 1 ? kBlockCost : 1) * size(runs_[i].first);
-  run_bounds_.assign(threads + 1, runs_.size());
-  run_ranges_ = std::vector<RunRange>(threads);
-  for (std::size_t t = 0; t < threads; ++t)
-    run_bounds_[t] = static_cast<std::size_t>(
-        std::lower_bound(cost_before.begin(), cost_before.end() - 1, cost_before.back() * t / threads) -
-        cost_before.begin());
   chunk_contacts_.assign(threads == 1 ? 1 : kChunksPerThread * threads, {});
-  thread_mailbox_.assign(threads, {});
+  threads_ = threads;
   contacts_.clear();
   contacts_known_ = false;
   pos_ = rest.positions;
-  strand_points_.assign(schedule_ == Schedule::Fused ? pos_.size() : 0, Vec3f::Zero());
-  strand_weights_.assign(strand_points_.size(), 0.0f);
-  node_sections_.assign(schedule_ == Schedule::Fused ? sys_.node_count() : 0, k::NodeSection{});
+  strand_points_.assign(pos_.size(), Vec3f::Zero());
+  strand_weights_.assign(pos_.size(), 0.0f);
+  prepare(threads);
   rebuild(Affine3f::Identity());
 }
 
-// Stage times inside a fused pass: every kTimingSample-th wisp is timed stage
-// by stage, and the pass's measured time is split between the stages in those
-// proportions (as the fused Han kernel samples its blocks).
-constexpr std::size_t kTimingSample = 8;
 
-void PlanteWispModel::WispClock::lap(int stage) {
-  if (!on) return;
-  const auto now = std::chrono::steady_clock::now();
-  sampled_ns[stage]->fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(now - last).count(),
-                               std::memory_order_relaxed);
-  last = now;
-}
-
-template <class F>
-void PlanteWispModel::for_each(std::size_t count, F&& f) {
-  // Static partition (ThreadPool::parallel_for); every caller's results are the same
-  // whichever thread runs which range. Below threads_min_wisps wisps, one thread.
-  if (ctx_.pool && sys_.wisp_count() >= static_cast<std::size_t>(threads_min_wisps_))
-    ctx_.pool->parallel_for(count, [&](std::size_t begin, std::size_t end) { f(begin, end); });
-  else
-    f(std::size_t{0}, count);
-}
-
-namespace {
-
-// A range of runs [front, back) packed as front << 32 | back, taken from either end.
-bool take_front(std::atomic<std::uint64_t>& range, std::size_t& i) {
-  std::uint64_t cur = range.load(std::memory_order_relaxed);
-  for (;;) {
-    const std::uint64_t front = cur >> 32, back = cur & 0xffffffffu;
-    if (front >= back) return false;
-    if (range.compare_exchange_weak(cur, (front + 1) << 32 | back, std::memory_order_relaxed)) {
-      i = static_cast<std::size_t>(front);
-      return true;
-    }
-  }
-}
-bool take_back(std::atomic<std::uint64_t>& range, std::size_t& i) {
-  std::uint64_t cur = range.load(std::memory_order_relaxed);
-  for (;;) {
-    const std::uint64_t front = cur >> 32, back = cur & 0xffffffffu;
-    if (front >= back) return false;
-    if (range.compare_exchange_weak(cur, front << 32 | (back - 1), std::memory_order_relaxed)) {
-      i = static_cast<std::size_t>(back - 1);
-      return true;
-    }
-  }
-}
-
-}  // namespace
-
-template <class F>
-void PlanteWispModel::wisp_pass(StageTimes& times, F&& f) {
-  for (auto& ns : sampled_ns_) ns.store(0, std::memory_order_relaxed);
-  const auto start = std::chrono::steady_clock::now();
-  // Each thread takes the runs of its range (run_bounds_, of about equal estimated
-  // cost) from the front; one that runs out takes the other ranges' runs from their back
-  // (the body contacts gather on some wisps, so equal estimated costs can still leave one
-  // thread far busier than the other). A thread keeps nearly the same wisps
-  // from step to step, in its cache, and which thread steps a wisp changes no bits.
-  const std::size_t parts = run_bounds_.size() - 1;
-  for (std::size_t p = 0; p < parts; ++p)
-    run_ranges_[p].range.store(static_cast<std::uint64_t>(run_bounds_[p]) << 32 | run_bounds_[p + 1],
-                               std::memory_order_relaxed);
-  for_each(parts, [&](std::size_t part_begin, std::size_t part_end) {
-    WispClock clock;
-    clock.sampled_ns = {&sampled_ns_[0], &sampled_ns_[1]};
-    auto run = [&](std::size_t i) {
-      clock.on = i % kTimingSample == 0;
-      if (clock.on) clock.last = std::chrono::steady_clock::now();
-      f(runs_[i], clock);
-    };
-    for (std::size_t p = part_begin; p < part_end; ++p) {
-      std::size_t i;
-      while (take_front(run_ranges_[p].range, i)) run(i);
-      for (std::size_t other = 1; other < parts; ++other)
-        while (take_back(run_ranges_[(p + other) % parts].range, i)) run(i);
-    }
-  });
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  const double integration = static_cast<double>(sampled_ns_[kIntegration].load(std::memory_order_relaxed));
-  const double bodies = static_cast<double>(sampled_ns_[kBody].load(std::memory_order_relaxed));
-  const double share = integration + bodies > 0.0 ? bodies / (integration + bodies) : 0.0;
-  times.add(Stage::Integrate, ms * (1.0 - share));
-  if (bodies > 0.0) times.add(Stage::BodyCollision, ms * share);
-}
-
-template <class F>
-void PlanteWispModel::stage_pass(StageTimes& times, Stage stage, F&& f) {
-  StageTimer t(times, stage);
-  for_each(sys_.wisp_count(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t w = begin; w < end; ++w) f(w);
-  });
-}
-
-std::size_t PlanteWispModel::state_bytes() const {
+std::size_t WispModel::state_bytes() const {
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   return bytes(sys_.x) + bytes(sys_.v) + bytes(sys_.acc) + bytes(sys_.e1) + bytes(sys_.e2) + bytes(sys_.n) +
          bytes(sys_.r) + bytes(sys_.rdot) + bytes(sys_.racc) + bytes(pos_);
 }
 
-std::size_t PlanteWispModel::block_wisps() const {
-  std::size_t n = 0;
-  for (const WispRun& run : runs_) n += run.count > 1 ? run.count : 0;
-  return n;
-}
-
-void PlanteWispModel::detect_self_interactions() {
-  const std::size_t chunks = chunk_contacts_.size(), threads = thread_mailbox_.size();
+void WispModel::detect_self_interactions() {
+  const std::size_t chunks = chunk_contacts_.size(), threads = threads_;
   k::grid_segments(grid_, sys_);
   const std::size_t n = grid_.size();
   for_each(n, [&](std::size_t begin, std::size_t end) { k::grid_setup(grid_, sys_, begin, end); });
-  if (schedule_ == Schedule::PerStage) {
-    k::grid_cells(grid_);
-  } else {
-    // The cells' loops over the segments on the threads (serial, they would take about an
-    // eighth of a detection's time on shake at 2 threads).
-    k::grid_frame(grid_, threads);
-    const std::size_t parts = grid_.part_begin.size() - 1;
-    auto over_parts = [&](auto step) {
-      for_each(parts, [&](std::size_t pb, std::size_t pe) {
-        for (std::size_t p = pb; p < pe; ++p) step(grid_, p);
-      });
-    };
-    over_parts(k::grid_count);
-    k::grid_offsets(grid_);
-    over_parts(k::grid_fill);
-  }
+  build_cells(threads);
   // Chunks of about equal candidates (grid_split), several per thread, claimed as the
   // threads come free: a chunk's cost also depends on how many of its candidates are
   // contacts, which no count ahead of the test knows (with one chunk of equal candidates
@@ -656,17 +509,10 @@ void PlanteWispModel::detect_self_interactions() {
   std::atomic<std::size_t> next{0};
   auto run = [&](std::size_t tb, std::size_t te) {
     for (std::size_t t = tb; t < te; ++t) {
-      // plante_wisp_ref: the plain narrow phase, the reference of the vector
-      // one. A segment is tested once by one thread, so a thread's mailbox serves all its
-      // chunks.
-      std::vector<std::uint32_t>& mailbox = thread_mailbox_[t];
-      if (schedule_ == Schedule::PerStage) mailbox.assign(n, std::numeric_limits<std::uint32_t>::max());
+      begin_narrow_phase(t, n);
       for (std::size_t c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
         chunk_contacts_[c].clear();
-        if (schedule_ == Schedule::PerStage)
-          k::grid_contacts_ref(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], mailbox, chunk_contacts_[c]);
-        else
-          block_.contacts(grid_, sys_, chunk_bounds_[c], chunk_bounds_[c + 1], chunk_contacts_[c]);
+        narrow_phase(t, chunk_bounds_[c], chunk_bounds_[c + 1], chunk_contacts_[c]);
       }
     }
   };
@@ -685,43 +531,10 @@ void PlanteWispModel::detect_self_interactions() {
   for_each(chunks, copy);
 }
 
-void PlanteWispModel::respond_to_contacts(float h) {
-  // k::wisp_contacts_respond in its two parts (ContactImpulse): the impulses over ranges
-  // of contacts (by the lane kernel, from the nodes' rows), then each thread sums them, in
-  // list order, on its own nodes' masses.
-  const std::size_t count = contacts_.size();
-  if (count == 0) return;
-  impulses_.resize(count);
-  const auto nodes = static_cast<std::uint32_t>(sys_.x.size());
-  contact_nodes_.resize(nodes);
-  for_each(nodes, [&](std::size_t begin, std::size_t end) {
-    k::wisp_soa::contact_nodes(sys_, params_, begin, end, contact_nodes_.data());
-  });
-  for_each(count, [&](std::size_t begin, std::size_t end) {
-    block_.impulses(sys_, contact_nodes_.data(), contacts_, begin, end, interaction_, params_, h, impulses_.data());
-  });
-  // The threads' node ranges hold about equal contacts, not equal nodes: contacts gather
-  // where the hair is dense (on model 1, equal nodes would give one thread about 5 times
-  // as many contacts to sum as the other). A chunk's
-  // contacts each touch a node of its own segments (the tested mass's or the volume's),
-  // so the ranges are cut at the chunks that split the list evenly. Any cut gives the
-  // same sums.
-  const std::size_t parts = thread_mailbox_.size(), chunks = chunk_offset_.size() - 1;
-  node_bounds_.assign(parts + 1, nodes);
-  node_bounds_[0] = 0;
-  for (std::size_t c = 0, p = 1; c < chunks && p < parts; ++c)
-    while (p < parts && chunk_offset_[c + 1] * parts >= count * p)
-      node_bounds_[p++] = chunk_bounds_[c + 1] < grid_.size() ? grid_.seg[chunk_bounds_[c + 1]] : nodes;
-  for_each(parts, [&](std::size_t pb, std::size_t pe) {
-    for (std::size_t p = pb; p < pe; ++p)
-      k::wisp_contacts_apply(sys_, contacts_, impulses_, node_bounds_[p], node_bounds_[p + 1]);
-  });
-}
-
 // §5.1, once per integration step: (1) forces, (2) interaction detection at its rate,
 // (3) velocities then their modifications, (4) positions then their modifications;
 // skeleton before envelope, root to tip (inside the kernels).
-void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
+void WispModel::step(const FrameInput& in, StageTimes& times) {
   const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm && sleep_.all_asleep()) {
     for (Stage stage : {Stage::Integrate, Stage::BodyCollision, Stage::SelfInteraction, Stage::Rebuild}) times.skip(stage);
@@ -774,63 +587,8 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
       body.motion = head * head_before.inverse();
       body.h = h;
     }
-    const k::wisp_soa::BodyLanes body_lanes(body);
     // Viscous friction over this step.
     const float drag = std::min(1.0f, interaction_.body_friction * h);
-    // §5.1 per wisp, root to tip inside the kernels: (1) forces and (3) velocities, the
-    // bodies' velocity modifications, then (4) positions and the bodies' position
-    // modifications. A wisp's stages touch only its own masses, so each wisp goes through
-    // them in one pass while it is in cache; the wisp-wisp response, which reads every
-    // wisp, splits the pass in two on the steps that detect. Same operations in the same
-    // order per wisp as the per-stage schedule (plante_wisp_ref): bit-identical.
-    auto velocities = [&](const WispRun& run, WispClock& clock) {
-      const k::WispParams& p = params_[sys_.wisp_params[run.first]];
-      for (std::uint32_t w = run.first; w < run.first + run.count; ++w) k::wisp_pin(sys_, w, head, h);
-      if (run.count == 1) {
-        k::wisp_forces_and_velocities(sys_, run.first, p, head_rot, in.gravity, in.wind, h);
-      } else {
-        std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
-        for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
-        block_.velocities(sys_, ids.data(), static_cast<int>(run.count), p, head_rot, in.gravity, in.wind, h);
-      }
-      clock.lap(kIntegration);
-      if (body_on) {
-        block_.body_slide(sys_, run.first, run.count, body_lanes, drag);
-        clock.lap(kBody);
-      }
-    };
-    auto positions = [&](const WispRun& run, WispClock& clock) {
-      std::array<Vec3f, k::wisp_soa::kLanes> root_e1;
-      for (std::uint32_t l = 0; l < run.count; ++l) root_e1[l] = head_rot * sys_.rest_e1[run.first + l];
-      if (run.count == 1) {
-        k::wisp_positions(sys_, run.first, root_e1[0], h);
-      } else {
-        std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
-        for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
-        block_.positions(sys_, ids.data(), static_cast<int>(run.count), root_e1.data(), h);
-      }
-      clock.lap(kIntegration);
-      if (body_on) {
-        block_.body_hold(sys_, run.first, run.count, body_lanes);
-        if (body_due) {
-          // The block kernel records the contacts of the wisps with no mass inside a body
-          // (nearly all); the per-wisp kernel moves the others' masses out.
-          std::uint32_t inside = ~0u;
-          if (run.count > 1) {
-            std::array<std::uint32_t, k::wisp_soa::kLanes> ids;
-            for (std::uint32_t l = 0; l < run.count; ++l) ids[l] = run.first + l;
-            inside = block_.body_detect(sys_, ids.data(), static_cast<int>(run.count), body_lanes,
-                                        interaction_.contact_threshold);
-          }
-          for (std::uint32_t l = 0; l < run.count; ++l) {
-            if (inside >> l & 1u)
-              k::wisp_body_detect(sys_, run.first + l, body, root_e1[l], interaction_.contact_threshold);
-            k::wisp_body_list(sys_, run.first + l);
-          }
-        }
-        clock.lap(kBody);
-      }
-    };
     // (2) + (3): wisp-wisp contacts are detected and responded to at the interaction
     // rate; the drag they apply stands for the whole period (§4.1 "proportional to ...
     // the time step"). After the bodies' modifications: a mass pressed against the head
@@ -839,40 +597,8 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
     // wisps touching that mass, and keep those on `idle` moving at up to 2 cm/s, 24 times
     // a second.
     const bool interact = crosses(interaction_hz_, i);
-    if (schedule_ == Schedule::PerStage) {
-      // plante_wisp_ref: the same stages in the same order, one pass over all wisps each
-      // (the plain schedule; it reads every wisp's state once per stage).
-      stage_pass(times, Stage::Integrate, [&](std::size_t w) {
-        k::wisp_pin(sys_, w, head, h);
-        k::wisp_forces_and_velocities(sys_, w, params_[sys_.wisp_params[w]], head_rot, in.gravity, in.wind, h);
-      });
-      if (body_on) stage_pass(times, Stage::BodyCollision, [&](std::size_t w) { k::wisp_body_slide(sys_, w, body, drag); });
-      if (interact) {
-        StageTimer t(times, Stage::SelfInteraction);
-        detect_self_interactions();
-        k::wisp_contacts_respond(sys_, contacts_, interaction_, params_, static_cast<float>(1.0 / interaction_hz_));
-      }
-      stage_pass(times, Stage::Integrate,
-                 [&](std::size_t w) { k::wisp_positions(sys_, w, head_rot * sys_.rest_e1[w], h); });
-      if (body_on) stage_pass(times, Stage::BodyCollision, [&](std::size_t w) { k::wisp_body_hold(sys_, w, body); });
-      if (body_due)
-        stage_pass(times, Stage::BodyCollision, [&](std::size_t w) {
-          k::wisp_body_detect(sys_, w, body, head_rot * sys_.rest_e1[w], interaction_.contact_threshold);
-        });
-    } else if (interact) {
-      wisp_pass(times, velocities);
-      {
-        StageTimer t(times, Stage::SelfInteraction);
-        detect_self_interactions();
-        respond_to_contacts(static_cast<float>(1.0 / interaction_hz_));
-      }
-      wisp_pass(times, positions);
-    } else {
-      wisp_pass(times, [&](const WispRun& run, WispClock& clock) {
-        velocities(run, clock);
-        positions(run, clock);
-      });
-    }
+    const StepInput s{in, head, head_rot, h, body, drag, body_on, body_due, interact};
+    integrate(s, times);
     head_before = head;
   }
   {
@@ -901,33 +627,17 @@ void PlanteWispModel::step(const FrameInput& in, StageTimes& times) {
 // The gap between the last pinned vertex and its section point (`anchor`) is carried
 // by the free vertices, fading with the section weight that already blends the axes
 // near the root (root_blend), so the strand stays attached to its root.
-void PlanteWispModel::rebuild(const Affine3f& head) {
+void WispModel::rebuild(const Affine3f& head) {
   const Eigen::Matrix3f head_rot = head.linear();
-  // plante_wisp sets up each node's part of the section frames once, then a strand's
-  // points 16 vertices at a time; plante_wisp_ref computes each point alone, the two
-  // nodes' parts included. Same bits.
-  const bool per_node = schedule_ == Schedule::Fused;
-  if (per_node) {
-    for_each(sys_.node_count(), [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k)
-        node_sections_[k] = k::node_section(sys_, static_cast<std::uint32_t>(k), head_rot);
-    });
-  }
+  prepare_sections(head_rot);
   auto body = [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t vb = rest_.strand_begin(s);
       const std::uint32_t n = rest_.strand_size(s);
-      const std::uint32_t* node = &vertex_node_[vb];
       auto pinned = [&](std::uint32_t i) { return rest_.positions[vb + i].w() == 0.0f; };
-      if (per_node && n > 0)
-        block_.strand_points(sys_, node_sections_.data(), node, &coord_[vb], n, &strand_points_[vb],
-                             &strand_weights_[vb]);
-      auto point = [&](std::uint32_t i) {
-        return per_node ? strand_points_[vb + i] : k::strand_point(sys_, node[i], coord_[vb + i], head_rot);
-      };
-      auto weight = [&](std::uint32_t i) {
-        return per_node ? strand_weights_[vb + i] : k::section_weight(sys_, node[i], coord_[vb + i].x());
-      };
+      section_points(s, head_rot);
+      auto point = [&](std::uint32_t i) { return strand_points_[vb + i]; };
+      auto weight = [&](std::uint32_t i) { return strand_weights_[vb + i]; };
       // Root to tip, each free vertex anchored to the last pinned one before it ...
       Vec3f anchor = Vec3f::Zero();
       int last = -1;
@@ -962,10 +672,6 @@ void PlanteWispModel::rebuild(const Affine3f& head) {
     }
   };
   for_each(rest_.strand_count(), body);
-}
-
-std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx, Schedule schedule) {
-  return std::make_unique<PlanteWispModel>(ctx, schedule);
 }
 
 }  // namespace hairbench::plante
