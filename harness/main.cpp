@@ -19,6 +19,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -384,8 +385,15 @@ int cmd_stress(StressArgs& a) {
 int cmd_list(const std::string& what) {
   if (what.empty()) throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
   if (what == "models") {
-    for (const ModelInfo& m : model_registry())
-      std::printf("%-14s %s\n", std::string(m.name).c_str(), std::string(m.summary).c_str());
+    int width = 0;
+    for (const ModelInfo& m : model_registry()) width = std::max(width, static_cast<int>(m.name.size()));
+    for (const ModelInfo& m : model_registry()) {
+      std::string line(m.summary);
+      if (!m.reference_of.empty())
+        line += "; the reference for " + std::string(m.reference_of) +
+                (m.reference_tolerance == 0.0 ? " (same bits)" : " (to rounding)");
+      std::printf("%-*s %s\n", width, std::string(m.name).c_str(), line.c_str());
+    }
     return 0;
   }
   if (what == "scenarios") {

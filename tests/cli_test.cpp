@@ -141,6 +141,9 @@ TEST(Cli, ListsModelsAndScenarios) {
   const hairbench::test::CliResult models = run_cli("list models");
   EXPECT_EQ(models.code, 0);
   for (const char* m : {"han_m1", "han_m2", "han_m3"}) EXPECT_NE(models.out.find(m), std::string::npos) << m;
+  // A reference implementation says which model it checks and how closely (ModelInfo).
+  EXPECT_NE(models.out.find("the reference for han_m1 (same bits)"), std::string::npos) << models.out;
+  EXPECT_NE(models.out.find("the reference for halen_forest (to rounding)"), std::string::npos) << models.out;
   const hairbench::test::CliResult scenarios = run_cli("list scenarios");
   EXPECT_EQ(scenarios.code, 0);
   for (const char* s : {"idle", "nod", "shake", "spin_fast", "walk", "tilt_upside_down", "wind_gust", "ponytail"})
