@@ -1,6 +1,8 @@
 #include "kernels/common/strand_kernels.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace hairbench::kernels {
 
@@ -35,6 +37,13 @@ void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& 
     pos[i].head<3>() = p + keep * (p - xyz(prev[i])) + acc * dt2;
     prev[i].head<3>() = p;
   }
+}
+
+float rounding_sized_length(std::span<const float> rest_length) {
+  if (rest_length.size() < 2) return 0.0f;
+  std::vector<float> sorted(rest_length.begin() + 1, rest_length.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return kRoundingSizedEdge * sorted[sorted.size() / 2];
 }
 
 void edge_length(std::span<Vec4f> pos, std::span<const float> rest_length) {

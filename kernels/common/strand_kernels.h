@@ -22,6 +22,17 @@ void follow_head(std::span<Vec4f> pos, std::span<Vec4f> prev, std::span<const Ve
 void verlet_integrate(std::span<Vec4f> pos, std::span<Vec4f> prev, const Vec3f& gravity,
                       const Wind& wind, bool wind_term, float damping, float dt);
 
+// A rest edge shorter than this fraction of its strand's median rest edge is
+// rounding-sized: its direction is mostly the float rounding of its end positions (an
+// edge of 2.4e-7 m 1 m from the origin, where a coordinate rounds by up to 6e-8 m, turns
+// by up to 0.24 rad when one coordinate of one end rounds). Han & Harada's method 2 and
+// Halén & Wester's cascade take no frame from such an edge.
+inline constexpr float kRoundingSizedEdge = 1e-3f;
+
+// One strand's rest edges (rest_length[i]: edge (i-1, i), index 0 unused) shorter than
+// this are rounding-sized: kRoundingSizedEdge times their median (0 without edges).
+float rounding_sized_length(std::span<const float> rest_length);
+
 // Edge length constraints (Müller et al. 2007, Halén & Wester Eq. 4.2) in even/odd edge
 // batches (Han & Harada §5), weighted by inverse mass.
 void edge_length(std::span<Vec4f> pos, std::span<const float> rest_length);

@@ -1,5 +1,7 @@
 #include "kernels/halen2007/reference/halen_kernels.h"
 
+#include "kernels/common/strand_kernels.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -63,9 +65,7 @@ void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int ex
   std::vector<float> arc(n), edge(n, 0.0f);
   arc_lengths(rest, arc);
   for (std::size_t i = 1; i < n; ++i) edge[i] = arc[i] - arc[i - 1];
-  std::vector<float> sorted(edge.begin() + 1, edge.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const float tiny = 1e-3f * sorted[sorted.size() / 2];
+  const float tiny = rounding_sized_length(edge);
   for (std::size_t i = 0; i < n; ++i) {
     inv_mass[i] = rest[i].w();
     k_up[i] = k_down[i] = lift[i] = lever[i] = 0.0f;

@@ -1,5 +1,6 @@
 #include "kernels/han2012/reference/han_kernels.h"
 
+#include "kernels/common/strand_kernels.h"
 #include "kernels/han2012/frames.h"
 
 #include <algorithm>
@@ -35,13 +36,6 @@ void init_rest_frames(std::span<const Vec4f> rest, std::span<Quatf> rest_rotatio
     // Algorithm 2 line 8: ^{i-1}T_i^0 is the rotation from (1,0,0) to ^{i-1}x_i^0.
     rest_rotation[i] = (parent * rotation_from_x(rest_local[i].normalized())).normalized();
   }
-}
-
-float rounding_sized_length(std::span<const float> rest_length) {
-  if (rest_length.size() < 2) return 0.0f;
-  std::vector<float> sorted(rest_length.begin() + 1, rest_length.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  return kRoundingSizedEdge * sorted[sorted.size() / 2];
 }
 
 void init_rounding_sized_frames(std::span<const float> rest_length, std::span<const Vec3f> rest_local,

@@ -24,16 +24,6 @@ void global_shape(std::span<Vec4f> pos, std::span<const Vec4f> rest, const Affin
 void init_rest_frames(std::span<const Vec4f> rest, std::span<Quatf> rest_rotation,
                       std::span<Vec3f> rest_local);
 
-// A rest edge shorter than this fraction of its strand's median rest edge is
-// rounding-sized: its direction is mostly the float rounding of its end positions (an
-// edge of 2.4e-7 m 1 m from the origin, where a coordinate rounds by up to 6e-8 m, turns
-// by up to 0.24 rad when one coordinate of one end rounds).
-inline constexpr float kRoundingSizedEdge = 1e-3f;
-
-// One strand's rest edges (rest_length[i]: edge (i-1, i), index 0 unused) shorter than
-// this are rounding-sized: kRoundingSizedEdge times their median (0 without edges).
-float rounding_sized_length(std::span<const float> rest_length);
-
 // Method 2's frames across rounding-sized rest edges, one strand: rounding_sized[i] is 1
 // where edge (i-1, i) is shorter than rounding_sized_length, and there rest_relative[i]
 // is ^{i-1}T_i^0, the rotation from (1,0,0) to ^{i-1}x_i^0 (Algorithm 2 line 8, the bits

@@ -1,6 +1,7 @@
 #include "models/han2012/vulkan/model.h"
 
 #include "core/error.h"
+#include "kernels/common/strand_kernels.h"
 #include "kernels/han2012/reference/han_kernels.h"
 #include "kernels/han2012/vulkan/han_layout.h"
 #include "kernels/vulkan/shaders.h"
