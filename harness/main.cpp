@@ -71,11 +71,12 @@ constexpr const char* kStressHelp =
     "and draws its heatmap DIR/stress_heatmap.png.";
 
 constexpr const char* kReproduceHelp =
-    "reproduce runs the configurations of the papers' published\n"
-    "tables (reports/published/) and writes DIR/reproduce.json,\n"
-    ".md and .html: per row the published and measured values and\n"
-    "a hardware-independent comparison, and the papers' claims as\n"
-    "checks, each with a verdict (holds / differs).";
+    "reproduce runs the papers' claims and tables\n"
+    "(reports/published/) at the papers' settings and writes\n"
+    "DIR/reproduce.json, .md, .html and the claims' charts: setup\n"
+    "rows (matches / mismatch), claims (holds / differs / not\n"
+    "testable, each with the paper's sentence) and measurements\n"
+    "(hardware-dependent numbers beside the paper's, no verdict).";
 
 struct KnobSpec {
   std::string name;
@@ -506,6 +507,7 @@ void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, Repr
   sub.add_option("--device", o.device, "Vulkan device for Han & Harada's GPU table, by index or\nname")
       ->type_name("NAME|INDEX");
   sub.add_option("--out", o.out, "the report's directory")->type_name("DIR")->capture_default_str();
+  sub.add_flag_callback("--no-charts", [&o] { o.charts = false; }, "no claim charts (reproduce.json, .md, .html only)");
 }
 
 // CLI11's parse errors in the project's one-line form, naming the argument and the

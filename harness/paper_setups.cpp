@@ -20,7 +20,8 @@ constexpr double kFig611Period = 2.0;  // shake's oscillation
 
 std::span<const PlanteStyle> plante_styles() { return kPlanteStyles; }
 
-PlanteStyleTiming time_plante_style(const PlanteStyle& style, int frames) {
+PlanteStyleTiming time_plante_style(const PlanteStyle& style, int frames,
+                                    const std::function<void(const plante::WispModel&)>& after_frame) {
   GroomSpec spec;
   spec.strands = style.wisps * kStrandsPerWisp;
   spec.vertices_per_strand = style.vertices;
@@ -48,6 +49,7 @@ PlanteStyleTiming time_plante_style(const PlanteStyle& style, int frames) {
     model.step(in, times);
     r.step_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     for (const auto& e : times.entries()) r.stage_ms[std::string(e.name)] += e.ms;
+    if (after_frame) after_frame(model);
   }
   const auto& s = model.wisps();
   r.wisps = static_cast<double>(s.wisp_count());

@@ -6,11 +6,16 @@
 #include "core/hair_model.h"
 #include "scenarios/scenario.h"
 
+#include <functional>
 #include <map>
 #include <span>
 #include <string>
 
 namespace hairbench {
+
+namespace plante {
+class WispModel;
+}
 
 // §5.3: short (199 wisps, ~4.0 segments), medium (73, ~9.9), long (56, ~7.7). Nodes per
 // wisp rounded to the paper's averages; lengths chosen so that segments are about as
@@ -31,8 +36,10 @@ struct PlanteStyleTiming {
 };
 // One style at the paper's rates (plante_wisp's defaults) and wisp counts (no splitting
 // of wide wisps), on one thread like the paper's single R12000, under the head script of
-// `shake` in `frames` frames of 1/24 s (the paper's frame rate).
-PlanteStyleTiming time_plante_style(const PlanteStyle& style, int frames);
+// `shake` in `frames` frames of 1/24 s (the paper's frame rate). `after_frame`, when
+// set, is shown the model after each frame, outside the timed steps.
+PlanteStyleTiming time_plante_style(const PlanteStyle& style, int frames,
+                                    const std::function<void(const plante::WispModel&)>& after_frame = {});
 
 // Figure 6.1.1: `strands` strands of `nodes` vertices generated on `shake`'s head.
 Scenario fig611_scenario(int strands, int nodes);

@@ -216,7 +216,7 @@ TEST(Cli, SweepBadArgumentsExitTwo) {
   for (const std::string& args :
        {std::string("sweep --knob local_iterations=1"), "sweep" + sc, "sweep" + sc + " --knob local_iterations=",
         "sweep" + sc + " --knob local_iterations=1,x", "sweep" + sc + " --knob local_iterations=1,1",
-        "sweep" + sc + " --knob local_iterations=100", "sweep" + sc + " --knob nosuch=1",
+        "sweep" + sc + " --knob local_iterations=300", "sweep" + sc + " --knob nosuch=1",
         "sweep" + sc + " --knob local_iterations=1.5", "sweep" + sc + " --knob =1",
         "sweep" + sc + " --knob local_iterations=1 --knob substeps=2",
         "sweep" + sc + " --knob local_iterations=1 --reference bogus",

@@ -1,7 +1,9 @@
-// `hairbench reproduce`: bad arguments are one-line errors with exit code 2;
-// a quick run of one table writes the report's three files, and every verdict in it
-// follows from the measured value and the stated bounds.
+// `hairbench reproduce`: bad arguments are one-line errors with exit code 2; every
+// verdict follows from its row's own fields; a quick run of every paper writes the three
+// kinds of rows, counted apart (no setup row counted as a claim), each claim with the
+// paper's sentence, and a self-contained page.
 #include "harness/reproduce.h"
+#include "harness/reproduce/rows.h"
 
 #include "cli_support.h"
 
@@ -10,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -20,6 +21,7 @@
 namespace {
 
 using hairbench::test::run_cli;
+namespace rp = hairbench::reproduce;
 
 std::string slurp(const std::filesystem::path& f) {
   std::ifstream in(f);
@@ -28,101 +30,152 @@ std::string slurp(const std::filesystem::path& f) {
   return s.str();
 }
 
-// The rule the report states: holds iff the measured value is a number within the bounds.
-void expect_verdict_follows(const nlohmann::json& c) {
+// The rule the report states: a claim holds iff the measured value is a number within the
+// bounds; a reason exactly when it does not hold; "not testable" carries its reason and no
+// measured value.
+void expect_claim_verdict_follows(const nlohmann::json& c) {
   SCOPED_TRACE(c["id"].get<std::string>());
+  EXPECT_FALSE(c["source"]["quote"].get<std::string>().empty()) << "every claim quotes the paper";
+  EXPECT_FALSE(c["source"]["where"].get<std::string>().empty());
+  EXPECT_FALSE(c["settings"].get<std::string>().empty()) << "every claim says what it ran at";
+  const std::string reason = c["reason"];
+  EXPECT_EQ(reason.find('\n'), std::string::npos) << "one line";
+  if (c["verdict"] == "not testable") {
+    EXPECT_TRUE(c["measured"].is_null());
+    EXPECT_FALSE(reason.empty());
+    return;
+  }
   const auto& lo = c["holds_if"]["min"];
   const auto& hi = c["holds_if"]["max"];
-  ASSERT_TRUE(!lo.is_null() || !hi.is_null()) << "a check without bounds decides nothing";
+  ASSERT_TRUE(!lo.is_null() || !hi.is_null()) << "a claim without bounds decides nothing";
+  EXPECT_FALSE(c["threshold_why"].get<std::string>().empty()) << "every bound says why";
   const bool holds = c["measured"].is_number() && (lo.is_null() || c["measured"].get<double>() >= lo.get<double>()) &&
                      (hi.is_null() || c["measured"].get<double>() <= hi.get<double>());
   EXPECT_EQ(c["verdict"], holds ? "holds" : "differs");
-  EXPECT_EQ(c["reason"].get<std::string>().empty(), holds) << "a reason exactly when it differs";
-  if (!holds) {
-    EXPECT_EQ(c["reason"].get<std::string>().find('\n'), std::string::npos) << "one line";
-  }
+  EXPECT_EQ(reason.empty(), holds) << "a reason exactly when it differs";
 }
 
 TEST(Reproduce, BadArgumentsExitTwo) {
   for (const char* args : {"reproduce", "reproduce nosuch", "reproduce han2012 --frames 0", "reproduce all --bogus",
-                           "reproduce plante2001 --frames", "reproduce halen2007 --threads x"}) {
+                           "reproduce plante2001 --frames", "reproduce halen2007 --threads x",
+                           "reproduce han2012 --no-charts=1"}) {
     const hairbench::test::CliResult r = run_cli(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << ": " << r.out;
   }
 }
 
-TEST(Reproduce, VerdictFollowsTheBounds) {
-  hairbench::ReproduceCheck c;
+TEST(Reproduce, ClaimVerdictFollowsTheBounds) {
+  rp::ClaimRow c;
   c.id = "x";
   c.min = 1.0;
   c.max = 2.0;
   c.why_differs = "because";
   for (double v : {1.0, 1.5, 2.0}) {
     c.measured = v;
-    EXPECT_EQ(hairbench::check_json(c)["verdict"], "holds") << v;
+    EXPECT_EQ(rp::to_json(c)["verdict"], "holds") << v;
   }
   for (double v : {0.5, 2.5, std::numeric_limits<double>::quiet_NaN()}) {
     c.measured = v;
-    const nlohmann::json j = hairbench::check_json(c);
+    const nlohmann::json j = rp::to_json(c);
     EXPECT_EQ(j["verdict"], "differs") << v;
     EXPECT_NE(j["reason"].get<std::string>().find("because"), std::string::npos);
   }
+  c.measured = 1.5;
+  c.not_testable = "no GPU here";
+  const nlohmann::json j = rp::to_json(c);
+  EXPECT_EQ(j["verdict"], "not testable");
+  EXPECT_EQ(j["reason"], "no GPU here");
+  EXPECT_TRUE(j["measured"].is_null());
+
+  rp::SetupRow s{"s", "what", {}, "3 spheres", "3 spheres", true};
+  EXPECT_EQ(rp::to_json(s)["verdict"], "matches");
+  s.matches = false;
+  EXPECT_EQ(rp::to_json(s)["verdict"], "mismatch");
+  EXPECT_FALSE(rp::to_json(rp::MeasurementRow{}).contains("verdict")) << "a measurement has no verdict";
 }
 
-// Plante's table at two frames per style: seconds, and every part of the report.
-TEST(Reproduce, QuickPlanteRunWritesTheReport) {
+// The scaling claims fit t = a + b N: exact on a line, and the slope's interval covers the
+// slope of noisy points drawn around one.
+TEST(Reproduce, LineFitRecoversSlopeAndInterval) {
+  const rp::LineFit exact = rp::fit_line({9, 25, 49, 121}, {5 + 2 * 9., 5 + 2 * 25., 5 + 2 * 49., 5 + 2 * 121.});
+  EXPECT_NEAR(exact.a, 5.0, 1e-9);
+  EXPECT_NEAR(exact.b, 2.0, 1e-12);
+  EXPECT_NEAR(exact.b_ci95, 0.0, 1e-9);
+  EXPECT_NEAR(exact.r2, 1.0, 1e-12);
+  const std::vector<double> x = {9, 25, 49, 81, 121, 169};
+  const std::vector<double> noise = {0.3, -0.5, 0.2, 0.4, -0.3, -0.1};
+  std::vector<double> y;
+  for (std::size_t i = 0; i < x.size(); ++i) y.push_back(1.0 + 0.2 * x[i] + noise[i]);
+  const rp::LineFit f = rp::fit_line(x, y);
+  EXPECT_GT(f.b_ci95, 0.0);
+  EXPECT_LT(std::fabs(f.b - 0.2), f.b_ci95);
+  EXPECT_LT(f.b_ci95, 0.02) << "six points with noise of 0.5 pin a slope to a few percent";
+}
+
+// Every paper at two frames per run: every part of the report and its rules.
+TEST(Reproduce, QuickRunOfEveryPaperWritesTheThreeKindsOfRows) {
   const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-reproduce-test";
   std::filesystem::remove_all(out);
-  const hairbench::test::CliResult r = run_cli("reproduce plante2001 --frames 2 --threads 1 --out \"" + out.string() + "\"");
+  const hairbench::test::CliResult r = run_cli("reproduce all --frames 2 --threads 2 --out \"" + out.string() + "\"");
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("## Verdicts"), std::string::npos) << r.out;
+  for (const char* heading : {"## Claims", "## Setup", "## Measurements"})
+    EXPECT_NE(r.out.find(heading), std::string::npos) << heading << "\n" << r.out;
 
   const nlohmann::json rep = nlohmann::json::parse(slurp(out / "reproduce.json"));
   EXPECT_EQ(rep["schema"], "hairbench-reproduce");
+  EXPECT_EQ(rep["schema_version"], 2);
   EXPECT_EQ(rep["frames_cap"], 2);
-  ASSERT_EQ(rep["papers"].size(), 1u);
-  const auto& paper = rep["papers"][0];
-  EXPECT_EQ(paper["id"], "plante2001");
-  ASSERT_EQ(paper["tables"].size(), 1u);
-  const auto& table = paper["tables"][0];
-  ASSERT_EQ(table["rows"].size(), 3u);  // short, medium, long
-  int checks = 0, holds = 0;
-  for (const auto& row : table["rows"]) {
-    SCOPED_TRACE(row["label"].get<std::string>());
-    EXPECT_EQ(row["published"].size(), table["published_columns"].size());
-    ASSERT_EQ(row["measured"].size(), table["measured_columns"].size());
-    // The styles' structure is the paper's: its wisp counts.
-    EXPECT_EQ(row["measured"][0], row["published"][0]);
-    // The comparison is computed from the row's measured interaction share.
-    const auto& c = row["comparison"];
-    ASSERT_TRUE(c.is_object());
-    EXPECT_DOUBLE_EQ(c["measured"].get<double>(), row["measured"][3].get<double>());
-    EXPECT_GT(c["measured"].get<double>(), 0.0);
-    EXPECT_LT(c["measured"].get<double>(), 1.0);
-    expect_verdict_follows(c);
-    ++checks;
-    holds += c["verdict"] == "holds";
-  }
-  ASSERT_GE(paper["checks"].size(), 3u);
-  for (const auto& c : paper["checks"]) {
-    expect_verdict_follows(c);
-    ++checks;
-    holds += c["verdict"] == "holds";
-  }
-  EXPECT_EQ(rep["summary"]["holds"], holds);
-  EXPECT_EQ(rep["summary"]["differs"], checks - holds);
-
+  ASSERT_EQ(rep["papers"].size(), 3u);
+  int matches = 0, mismatches = 0, holds = 0, differs = 0, untestable = 0, measurements = 0;
   const std::string md = slurp(out / "reproduce.md");
   const std::string html = slurp(out / "reproduce.html");
-  for (const auto& c : paper["checks"]) {
-    EXPECT_NE(md.find(c["id"].get<std::string>()), std::string::npos) << c["id"];
-    EXPECT_NE(html.find(c["id"].get<std::string>()), std::string::npos) << c["id"];
+  for (const auto& paper : rep["papers"]) {
+    SCOPED_TRACE(paper["id"].get<std::string>());
+    EXPECT_FALSE(paper["setups"].empty());
+    EXPECT_FALSE(paper["claims"].empty());
+    EXPECT_FALSE(paper["measurements"].empty());
+    for (const auto& s : paper["setups"]) {
+      EXPECT_EQ(s["kind"], "setup");
+      ASSERT_TRUE(s["verdict"] == "matches" || s["verdict"] == "mismatch") << s;
+      // The configuration is the papers' whatever the frame cap: every setup row matches.
+      EXPECT_EQ(s["verdict"], "matches") << s;
+      (s["verdict"] == "matches" ? matches : mismatches)++;
+    }
+    for (const auto& c : paper["claims"]) {
+      EXPECT_EQ(c["kind"], "claim");
+      expect_claim_verdict_follows(c);
+      const std::string v = c["verdict"];
+      (v == "holds" ? holds : v == "differs" ? differs : untestable)++;
+      EXPECT_NE(md.find(c["source"]["quote"].get<std::string>()), std::string::npos) << "the paper's sentence";
+      EXPECT_NE(html.find(c["id"].get<std::string>()), std::string::npos) << c["id"];
+      if (!c["chart"].is_null()) {
+        EXPECT_TRUE(std::filesystem::exists(out / "charts" /
+                                            (paper["id"].get<std::string>() + "_" + c["id"].get<std::string>() + ".png")))
+            << c["id"];
+        for (const auto& s : c["chart"]["series"]) EXPECT_EQ(s["y"].size(), c["chart"]["x"].size());
+      }
+    }
+    for (const auto& m : paper["measurements"]) {
+      EXPECT_EQ(m["kind"], "measurement");
+      EXPECT_FALSE(m.contains("verdict"));
+      EXPECT_EQ(m["published"].size(), m["columns"].size()) << m["id"];
+      EXPECT_EQ(m["measured"].size(), m["columns"].size()) << m["id"];
+      ++measurements;
+    }
   }
-  // Self-contained: one file to open or attach, nothing loaded from elsewhere.
+  EXPECT_EQ(rep["summary"]["setup"]["matches"], matches);
+  EXPECT_EQ(rep["summary"]["setup"]["mismatches"], mismatches);
+  EXPECT_EQ(rep["summary"]["claims"]["holds"], holds);
+  EXPECT_EQ(rep["summary"]["claims"]["differs"], differs);
+  EXPECT_EQ(rep["summary"]["claims"]["not_testable"], untestable);
+  EXPECT_EQ(rep["summary"]["measurements"], measurements);
+
+  // Self-contained: one file to open or attach; its only images are inlined.
   EXPECT_NE(html.find("<table>"), std::string::npos);
-  EXPECT_EQ(html.find("src="), std::string::npos);
   EXPECT_EQ(html.find("<link"), std::string::npos);
+  for (std::size_t i = html.find("src=\""); i != std::string::npos; i = html.find("src=\"", i + 1))
+    EXPECT_EQ(html.compare(i, 16, "src=\"data:image/"), 0) << html.substr(i, 40);
   std::filesystem::remove_all(out);
 }
 

@@ -201,6 +201,16 @@ void grid_split(const SegmentGrid& g, std::size_t parts, std::vector<std::size_t
 
 namespace {
 
+// Segments i < j of one wisp within two segments of each other share a node or meet at
+// one: the narrow phase never tests them.
+bool neighbours(const SegmentGrid& g, std::size_t i, std::size_t j) {
+  return g.wisp[j] == g.wisp[i] && g.seg[j] - g.seg[i] < 3;
+}
+
+bool boxes_overlap(const SegmentGrid& g, std::size_t i, std::size_t j) {
+  return !((g.lo[i].array() > g.hi[j].array()).any() || (g.lo[j].array() > g.hi[i].array()).any());
+}
+
 // Node seg[i] + 1's masses (the node, then its envelope masses) in segment j's volume.
 void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::size_t j, std::vector<WispContact>& out) {
   const std::uint32_t k = g.seg[i] + 1;
@@ -219,7 +229,6 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
 void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                        std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
   for (std::size_t i = begin; i < end; ++i) {
-    const std::uint32_t a = g.seg[i];
     for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
       for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
         for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
@@ -228,14 +237,65 @@ void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t be
             const std::uint32_t j = g.cell_items[it];
             if (j <= i || mailbox[j] == i) continue;
             mailbox[j] = static_cast<std::uint32_t>(i);
-            const std::uint32_t b = g.seg[j];
-            if (g.wisp[j] == g.wisp[i] && b - a < 3) continue;  // b > a within a wisp
-            if ((g.lo[i].array() > g.hi[j].array()).any() || (g.lo[j].array() > g.hi[i].array()).any()) continue;
+            if (neighbours(g, i, j) || !boxes_overlap(g, i, j)) continue;
             masses_in(g, s, i, j, out);
             masses_in(g, s, j, i, out);
           }
         }
   }
+}
+
+GridTestCounts grid_test_counts(const SegmentGrid& g, std::span<const WispContact> contacts) {
+  GridTestCounts c;
+  const std::size_t n = g.size();
+  c.segments = n;
+  std::vector<std::uint32_t> mailbox(n, ~0u);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n && neighbours(g, i, j); ++j) ++c.neighbour_pairs;
+    for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
+      for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
+        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+          const std::size_t cell = g.cell_at(x, y, z);
+          for (std::uint32_t it = g.cell_start[cell]; it < g.cell_start[cell + 1]; ++it) {
+            const std::uint32_t j = g.cell_items[it];
+            if (j <= i || mailbox[j] == i) continue;
+            mailbox[j] = static_cast<std::uint32_t>(i);
+            if (neighbours(g, i, j)) continue;
+            ++c.box_tests;
+            if (!boxes_overlap(g, i, j)) continue;
+            ++c.box_overlaps;
+            c.volume_tests += kMassesPerSegment * (g.mass_free[i] + g.mass_free[j]);
+          }
+        }
+  }
+  // A contact is a mass of node k, owned by segment (k - 1, k), inside segment c.seg's
+  // volume; the segments ascend by first node (grid_segments).
+  auto index = [&](std::uint32_t first_node) {
+    return static_cast<std::uint64_t>(std::lower_bound(g.seg.begin(), g.seg.end(), first_node) - g.seg.begin());
+  };
+  std::vector<std::uint64_t> pairs;
+  pairs.reserve(contacts.size());
+  for (const WispContact& k : contacts) {
+    const std::uint32_t node = k.envelope ? k.point / kEnvelopePerSection : k.point;
+    const std::uint64_t a = index(node - 1), b = index(k.seg);
+    pairs.push_back(std::min(a, b) << 32 | std::max(a, b));
+  }
+  std::ranges::sort(pairs);
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  c.intersecting_pairs = pairs.size();
+  std::vector<std::uint64_t> touched;
+  for (const std::uint64_t p : pairs) {
+    const std::uint64_t i = p >> 32, j = p & 0xffffffffu;
+    if (g.wisp[i] == g.wisp[j]) {
+      ++c.own_wisp_pairs;
+      continue;
+    }
+    touched.push_back(i << 32 | g.wisp[j]);
+    touched.push_back(j << 32 | g.wisp[i]);
+  }
+  std::ranges::sort(touched);
+  c.wisp_contacts = static_cast<std::uint64_t>(std::unique(touched.begin(), touched.end()) - touched.begin());
+  return c;
 }
 
 }  // namespace hairbench::kernels

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace hairbench::kernels {
@@ -102,6 +103,26 @@ void grid_fill(SegmentGrid& g, std::size_t part);
 // tested where it is first met.
 void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                        std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out);
+
+// What a detection's narrow phase tests, counted as §4.1 describes it (grid_contacts_ref's
+// order): each pair of segments met in a shared cell is tested once (the mailbox),
+// neighbours within two segments of one wisp excepted; its bounding boxes are compared;
+// where they overlap, each mass of a free node of either segment is tested in the other's
+// volume. A pair intersects when at least one of those masses is inside (§4.1's
+// collision), read from the detection's contacts.
+struct GridTestCounts {
+  std::uint64_t segments = 0;            // that take part (SegmentGrid::size)
+  std::uint64_t box_tests = 0;           // pairs whose bounding boxes are compared
+  std::uint64_t box_overlaps = 0;        // of those, pairs whose boxes overlap
+  std::uint64_t volume_tests = 0;        // mass-in-volume tests of the overlapping pairs
+  std::uint64_t intersecting_pairs = 0;  // pairs with a mass of either inside the other
+  std::uint64_t own_wisp_pairs = 0;      // of those, pairs of one wisp's segments
+  std::uint64_t wisp_contacts = 0;       // (segment, other wisp) with an intersecting pair
+  std::uint64_t neighbour_pairs = 0;     // neighbours within two segments of one wisp, never tested
+};
+// The counts of the detection that built `g` and found `contacts` (WispModel::grid() and
+// contacts() after it, or grid_build and grid_contacts_ref).
+GridTestCounts grid_test_counts(const SegmentGrid& g, std::span<const WispContact> contacts);
 
 // Bounds of `parts` contiguous ranges of segments with about equal candidates each:
 // range p is [bounds[p], bounds[p + 1]).

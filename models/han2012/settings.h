@@ -24,7 +24,9 @@ inline constexpr std::array<ParamSpec, 9> kParams{{
     {"global_ramp", 1.0, 0.0, 1.0, true,
      "1: S_G falls linearly to 0 at the end of global_range (§3.3)"},
     {"local_stiffness", 0.9, 0.0, 1.0, false, "S_L of Eq. 3-4"},
-    {"local_iterations", 1, 0, 64, true, "local shape constraint iterations per (sub)step"},
+    // Up to a strand's most vertices (kMaxStrandVertices): method 2 (Algorithm 4) moves a
+    // correction one vertex per iteration, so converging it on the longest strand takes that many.
+    {"local_iterations", 1, 0, 256, true, "local shape constraint iterations per (sub)step"},
     {"length_iterations", 3, 0, 64, true, "edge length constraint iterations per (sub)step"},
     {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
     {"method", 0, 0, 3, true,

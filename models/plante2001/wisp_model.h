@@ -47,8 +47,10 @@ class WispModel : public HairModel {
   // Rebuilds positions() from the current wisp state under head transform `head` (done
   // at the end of every step; public so that tests can rebuild from an edited state).
   void rebuild(const Affine3f& head);
-  // Contacts of the last wisp-wisp detection.
+  // Contacts of the last wisp-wisp detection, and the grid it built (its segments,
+  // boxes and cells as they were then: kernels::grid_test_counts).
   std::span<const kernels::WispContact> contacts() const { return contacts_; }
+  const kernels::SegmentGrid& grid() const { return grid_; }
 
  protected:
   explicit WispModel(const ModelContext& ctx);
