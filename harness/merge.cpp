@@ -18,9 +18,9 @@ using nlohmann::json;
 
 ShardReport read_shard_report(const std::string& file) {
   std::ifstream in(file);
-  if (!in) throw InputError(file, "", "cannot read the shard report");
+  if (!in) throw InputError("merge", file, "cannot read the shard report");
   json j = json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) throw InputError(file, "", "not JSON");
+  if (j.is_discarded() || !j.is_object()) throw InputError("merge", file, "not a JSON object");
   if (j.value("schema", "") != "hairbench-report") throw InputError(file, "schema", "not a hairbench-report");
   const json& s = j.value("shard", json());
   if (!s.is_object())

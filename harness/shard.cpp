@@ -128,9 +128,9 @@ std::string fmt(const char* f, double v) {
 CostModel CostModel::from_report(const std::filesystem::path& file) {
   const std::string f = file.string();
   std::ifstream in(file);
-  if (!in) throw InputError(f, "", "cannot read the --costs report");
+  if (!in) throw InputError("--costs", f, "cannot read the report");
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded()) throw InputError(f, "", "not JSON");
+  if (j.is_discarded()) throw InputError("--costs", f, "not JSON");
   if (j.value("schema", "") != "hairbench-report") throw InputError(f, "schema", "not a hairbench-report");
   if (!j.contains("runs") || !j["runs"].is_array() || j["runs"].empty())
     throw InputError(f, "runs", "missing or empty: --costs needs a report with runs");
