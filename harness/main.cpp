@@ -537,7 +537,7 @@ void add_shard_options(CLI::App& sub, std::string& shard, bool& plan_only, std::
                  "N), cut by estimated cost; hairbench merge joins the parts")
       ->type_name("I/N");
   sub.add_flag_callback("--plan", [&plan_only] { plan_only = true; },
-                        "print the run list, each shard's part and its estimated\ncost, and exit");
+                        std::string("print the ") + unit + " list and each shard's part (with\nits estimated cost), and exit");
   if (costs)
     sub.add_option("--costs", *costs,
                    "estimate the runs' costs from this earlier report's step\ntimes instead of the built-in table")
