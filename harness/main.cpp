@@ -6,9 +6,11 @@
 #include "git_sha.h"
 #include "harness/charts.h"
 #include "harness/gpu_clock.h"
+#include "harness/merge.h"
 #include "harness/progress.h"
 #include "harness/reproduce.h"
 #include "harness/runner.h"
+#include "harness/shard.h"
 #include "harness/stress.h"
 #include "models/registry.h"
 #include "reports/report.h"
@@ -70,6 +72,13 @@ constexpr const char* kStressHelp =
     "degenerate grooms, prints the table, writes DIR/stress.json\n"
     "and draws its heatmap DIR/stress_heatmap.png.";
 
+constexpr const char* kMergeHelp =
+    "merge writes one report, OUT_DIR/report.json (or stress.json)\n"
+    "with its charts, from the reports of the shards of one\n"
+    "command (--shard I/N); it refuses shards of different\n"
+    "builds, scenarios or plans, reference runs that differ,\n"
+    "duplicate runs and missing ones.";
+
 constexpr const char* kReproduceHelp =
     "reproduce runs the papers' claims and tables\n"
     "(reports/published/) at the papers' settings and writes\n"
@@ -93,7 +102,12 @@ struct CompareArgs {
   int threads = 0;
   std::string out;
   bool charts = true;
+  std::string shard_arg;  // --shard I/N
+  bool plan_only = false;  // --plan
+  std::string costs;       // --costs REPORT.json
   // Resolved by prepare_compare.
+  ShardSpec shard;
+  CostModel cost_model;
   RunOptions run;
   std::vector<std::string> skipped;  // models left out, and why (printed once the inputs are good)
   std::optional<KnobSpec> knob;
@@ -194,6 +208,8 @@ void prepare_compare(CompareArgs& a, bool sweep) {
     throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "' (or 'converged')");
   }
   if (a.knob) select_knob_models(a);
+  if (!a.shard_arg.empty()) a.shard = parse_shard(a.shard_arg);
+  if (!a.costs.empty()) a.cost_model = CostModel::from_report(a.costs);
 }
 
 void print_run(const nlohmann::json& r) {
@@ -254,7 +270,7 @@ std::vector<DeviceRecord> gpu_devices(const CompareArgs& a) {
 // clocks are read again as it is written.
 int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<DeviceRecord> devices,
                  const std::vector<RunRecord>& runs, const std::vector<ScenarioRecord>& scenarios,
-                 const nlohmann::json& sweep) {
+                 const nlohmann::json& sweep, const Plan& plan) {
   for (DeviceRecord& d : devices) {
     const GpuClock clock = read_gpu_clock(d.name);
     d.clock_end_mhz = clock.mhz;
@@ -263,6 +279,7 @@ int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<Devic
   const std::filesystem::path out = std::filesystem::path(a.out) / "report.json";
   nlohmann::json report = make_report(ReportContext{pool.threads(), std::move(devices)}, runs, scenarios);
   if (!sweep.is_null()) report["sweep"] = sweep;
+  if (a.shard.active()) report["shard"] = shard_json(plan, a.shard);
   write_json(out, report);
   std::printf("wrote %s\n", out.string().c_str());
   return a.charts ? draw_charts(out) : 0;
@@ -282,57 +299,54 @@ void print_header(const Scenario& sc, const CompareArgs& a) {
               sc.groom.vertex_count(), a.run.frames > 0 ? a.run.frames : sc.frames);
 }
 
-int cmd_compare(CompareArgs& a) {
-  prepare_compare(a, false);
+// compare and sweep: per scenario, one lockstep batch per knob value (one batch without
+// a knob), each running the plan's models of this shard (every model unsharded) beside
+// the reference, which every batch runs for itself.
+int run_batches(CompareArgs& a, bool sweep) {
+  prepare_compare(a, sweep);
   const std::vector<Scenario> scenarios = load_scenarios(a);
-  std::vector<DeviceRecord> devices = gpu_devices(a);
-
-  ThreadPool pool(a.threads);
-  Progress progress(static_cast<int>(scenarios.size() * a.run.models.size()), true);
-  std::vector<RunRecord> runs;
-  std::vector<ScenarioRecord> records;
-  for (const Scenario& sc : scenarios) {
-    print_header(sc, a);
-    std::fflush(stdout);
-    RunOptions opt = a.run;
-    opt.scenario_record = &records.emplace_back();
-    opt.on_frame = [&](int done, int frames) { progress.frame(done, frames); };
-    progress.begin(static_cast<int>(a.run.models.size()), sc.name);
-    std::vector<RunRecord> got = run_scenario(sc, opt, pool);
-    progress.end();
-    for (const RunRecord& r : got) print_run(run_json(r));
-    std::fflush(stdout);
-    for (RunRecord& r : got) runs.push_back(std::move(r));
+  const std::vector<double> values = a.knob ? a.knob->values : std::vector<double>{};
+  const std::string knob_name = a.knob ? a.knob->name : "";
+  const Plan plan = plan_runs(scenarios, a.run, knob_name, values, a.cost_model, a.shard.active() ? a.shard.count : 1);
+  if (a.plan_only) {
+    std::fputs(plan_text(plan, sweep ? "sweep" : "compare").c_str(), stdout);
+    return 0;
   }
-  return write_report(a, pool, std::move(devices), runs, records, nullptr);
-}
-
-// Every selected model at every knob value, one lockstep batch per value: the reference
-// (at the scenario's parameters, or converged) is the same in every batch.
-int cmd_sweep(CompareArgs& a) {
-  prepare_compare(a, true);
-  const KnobSpec& knob = *a.knob;
-  const std::vector<Scenario> scenarios = load_scenarios(a);
   std::vector<DeviceRecord> devices = gpu_devices(a);
+  const int mine = a.shard.active() ? a.shard.index : 1;
+  int total = 0;
+  for (const PlanItem& it : plan.items) total += it.shard == mine;
 
   ThreadPool pool(a.threads);
-  const int per_batch = static_cast<int>(a.run.models.size());
-  Progress progress(static_cast<int>(scenarios.size() * knob.values.size()) * per_batch, true);
+  Progress progress(total, true);
   std::vector<RunRecord> runs;
   std::vector<ScenarioRecord> records;
+  std::size_t item = 0;
   for (const Scenario& sc : scenarios) {
-    print_header(sc, a);
-    std::fflush(stdout);
-    for (std::size_t k = 0; k < knob.values.size(); ++k) {
-      const double value = knob.values[k];
+    bool recorded = false;
+    for (std::size_t k = 0; k < std::max<std::size_t>(values.size(), 1); ++k) {
       RunOptions opt = a.run;
-      for (const std::string& m : a.run.models) opt.model_overrides.push_back({m, knob.name, value});
-      opt.knob = RunRecord::Knob{knob.name, value};
-      if (k == 0) opt.scenario_record = &records.emplace_back();
+      opt.models.clear();
+      for (const std::string& m : a.run.models)
+        if (plan.items[item++].shard == mine) opt.models.push_back(m);
+      if (opt.models.empty()) continue;
+      if (!recorded) {
+        print_header(sc, a);
+        opt.scenario_record = &records.emplace_back();
+        recorded = true;
+      }
+      std::fflush(stdout);
+      std::string what = sc.name;
+      if (a.knob) {
+        const double value = values[k];
+        for (const std::string& m : opt.models) opt.model_overrides.push_back({m, knob_name, value});
+        opt.knob = RunRecord::Knob{knob_name, value};
+        char v[64];
+        std::snprintf(v, sizeof v, " %s=%g", knob_name.c_str(), value);
+        what += v;
+      }
       opt.on_frame = [&](int done, int frames) { progress.frame(done, frames); };
-      char what[160];
-      std::snprintf(what, sizeof what, "%s %s=%g", sc.name.c_str(), knob.name.c_str(), value);
-      progress.begin(per_batch, what);
+      progress.begin(static_cast<int>(opt.models.size()), what);
       std::vector<RunRecord> got = run_scenario(sc, opt, pool);
       progress.end();
       for (const RunRecord& r : got) print_run(run_json(r));
@@ -340,8 +354,9 @@ int cmd_sweep(CompareArgs& a) {
       for (RunRecord& r : got) runs.push_back(std::move(r));
     }
   }
-  const nlohmann::json sweep = {{"knob", knob.name}, {"values", knob.values}, {"models", a.run.models}};
-  return write_report(a, pool, std::move(devices), runs, records, sweep);
+  nlohmann::json sweep_json;
+  if (a.knob) sweep_json = {{"knob", knob_name}, {"values", values}, {"models", a.run.models}};
+  return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan);
 }
 
 struct StressArgs {
@@ -350,6 +365,9 @@ struct StressArgs {
   std::string out = "reports/out/stress";
   int threads = 0;
   bool charts = true;
+  std::string shard_arg;
+  bool plan_only = false;
+  std::string costs;
 };
 
 int cmd_stress(StressArgs& a) {
@@ -364,6 +382,19 @@ int cmd_stress(StressArgs& a) {
   for (const ModelInfo& m : model_registry())
     if (m.platform == Platform::Cpu && std::regex_match(std::string(m.name), re)) a.opt.models.emplace_back(m.name);
   if (a.opt.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no CPU model");
+  const ShardSpec shard = a.shard_arg.empty() ? ShardSpec{} : parse_shard(a.shard_arg);
+  const CostModel costs = a.costs.empty() ? CostModel{} : CostModel::from_report(a.costs);
+  Plan plan;
+  if (shard.active() || a.plan_only) {
+    plan = plan_stress(a.opt, costs, shard.active() ? shard.count : 1);
+    if (a.plan_only) {
+      std::fputs(plan_text(plan, "stress").c_str(), stdout);
+      return 0;
+    }
+    a.opt.only.emplace();
+    for (const PlanItem& it : plan.items)
+      if (it.shard == shard.index) a.opt.only->insert(it.key);
+  }
   ThreadPool pool(a.threads);
   const bool tty = isatty(fileno(stderr));
   const auto start = std::chrono::steady_clock::now();
@@ -377,10 +408,71 @@ int cmd_stress(StressArgs& a) {
   std::fputs(stress_table(result).c_str(), stdout);
   nlohmann::json report = make_report(ReportContext{pool.threads(), {}}, {});
   report["stress"] = stress_json(result);
+  if (shard.active()) report["shard"] = shard_json(plan, shard);
   const std::filesystem::path file = std::filesystem::path(a.out) / "stress.json";
   write_json(file, report);
   std::printf("wrote %s\n", file.string().c_str());
   return a.charts ? draw_charts(file, "stress_chart.py") : 0;
+}
+
+struct MergeArgs {
+  std::string out;
+  std::vector<std::string> files;
+  bool mix_machines = false;
+  bool charts = true;
+};
+
+int cmd_merge(const MergeArgs& a) {
+  std::vector<ShardReport> shards;
+  for (const std::string& f : a.files) shards.push_back(read_shard_report(f));
+  const bool stress = shards.front().report.contains("stress");
+  const nlohmann::json merged = stress ? merge_stress_reports(shards) : merge_reports(shards, a.mix_machines);
+  const std::filesystem::path file = std::filesystem::path(a.out) / (stress ? "stress.json" : "report.json");
+  write_json(file, merged);
+  const nlohmann::json& m = merged["merge"];
+  std::printf("merged %zu shards of %d (%zu %s, %zu machine%s) into %s\n", shards.size(), m["count"].get<int>(),
+              (stress ? merged["stress"]["axes"].size() + merged["stress"]["degenerate"].size() : merged["runs"].size()),
+              stress ? "stress rows" : "runs", m["machines"].size(), m["machines"].size() == 1 ? "" : "s",
+              file.string().c_str());
+  for (const nlohmann::json& s : m["shards"])
+    std::printf("  shard %d: %s, machine %d: %s\n", s["index"].get<int>(), s["file"].get<std::string>().c_str(),
+                s["machine"].get<int>() + 1, m["machines"][s["machine"].get<std::size_t>()].get<std::string>().c_str());
+  if (!a.charts) return 0;
+  return stress ? draw_charts(file, "stress_chart.py") : draw_charts(file);
+}
+
+// reproduce --shard I/N: whole papers, not runs, since each paper's checks compare rows
+// measured in one process (ratios of times, growth with size); papers go to shards in
+// turn. Returns false when this shard has no paper (or --plan printed the cut).
+struct ReproduceShard {
+  std::string arg;
+  bool plan_only = false;
+};
+
+bool shard_papers(std::vector<std::string>& papers, const ReproduceShard& rs) {
+  if (rs.arg.empty() && !rs.plan_only) return true;
+  const ShardSpec shard = rs.arg.empty() ? ShardSpec{1, 1} : parse_shard(rs.arg);
+  std::vector<std::string> mine;
+  for (std::size_t i = 0; i < papers.size(); ++i)
+    if (static_cast<int>(i % static_cast<std::size_t>(shard.count)) + 1 == shard.index) mine.push_back(papers[i]);
+  if (rs.plan_only) {
+    std::printf("reproduce: %zu papers, %d shard%s; whole papers (no cost estimate: a paper is not a run list)\n",
+                papers.size(), shard.count, shard.count == 1 ? "" : "s");
+    for (int s = 1; s <= shard.count; ++s) {
+      std::string list;
+      for (std::size_t i = 0; i < papers.size(); ++i)
+        if (static_cast<int>(i % static_cast<std::size_t>(shard.count)) + 1 == s) list += " " + papers[i];
+      std::printf("shard %d/%d:%s\n", s, shard.count, list.empty() ? " (none)" : list.c_str());
+    }
+    return false;
+  }
+  if (mine.empty()) {
+    std::printf("reproduce: shard %d/%d has no paper (%zu papers): nothing to run\n", shard.index, shard.count,
+                papers.size());
+    return false;
+  }
+  papers = std::move(mine);
+  return true;
 }
 
 int cmd_list(const std::string& what) {
@@ -438,6 +530,35 @@ void add_threads_option(CLI::App& sub, int& threads) {
       ->check(whole_number(1, 1024));
 }
 
+// --shard, --plan and --costs: the same for every subcommand that has a run list
+// (reproduce cuts whole papers and takes no --costs).
+void add_shard_options(CLI::App& sub, std::string& shard, bool& plan_only, std::string* costs, const char* unit) {
+  sub.add_option("--shard", shard,
+                 std::string("run only part I of N of the ") + unit + " list (1 <= I <=\n"
+                 "N), cut by estimated cost; hairbench merge joins the parts")
+      ->type_name("I/N");
+  sub.add_flag_callback("--plan", [&plan_only] { plan_only = true; },
+                        std::string("print the ") + unit + " list and each shard's part (with\nits estimated cost), and exit");
+  if (costs)
+    sub.add_option("--costs", *costs,
+                   "estimate the runs' costs from this earlier report's step\ntimes instead of the built-in table")
+        ->type_name("REPORT.json");
+}
+
+void add_merge_options(CLI::App& sub, MergeArgs& a) {
+  sub.add_option("OUT_DIR", a.out, "where the merged report and its charts go")->type_name("OUT_DIR")->required();
+  sub.add_option("REPORT", a.files, "the shards' report.json (or stress.json) files")
+      ->type_name("REPORT.json...")
+      ->expected(1, -1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->required();
+  sub.add_flag_callback("--mix-machines", [&a] { a.mix_machines = true; },
+                        "let a chart compare times measured on different machines\n"
+                        "(each such chart says so); by default each machine's\n"
+                        "runs are timed apart");
+  sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write the report only");
+}
+
 // The options compare and sweep share; sweep adds --knob and needs --scenario.
 void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
   a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
@@ -475,6 +596,7 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
                  "Vulkan device of the *_vk models, by index or name (see\n"
                  "list devices; default: the first discrete GPU, else any)")
       ->type_name("NAME|INDEX");
+  add_shard_options(sub, a.shard_arg, a.plan_only, &a.costs, "run");
   sub.add_flag_callback("--no-skip", [&a] { a.run.skip_inert = false; },
                         "run every stage even where the scene makes it inert (no\n"
                         "colliders, no wind, zero stiffness) and never let strands\n"
@@ -495,9 +617,10 @@ void add_stress_options(CLI::App& sub, StressArgs& a) {
   add_threads_option(sub, a.threads);
   sub.add_option("--out", a.out, "the report's directory")->type_name("DIR")->capture_default_str();
   sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write stress.json only, no heatmap");
+  add_shard_options(sub, a.shard_arg, a.plan_only, &a.costs, "run");
 }
 
-void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, ReproduceOptions& o) {
+void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, ReproduceOptions& o, ReproduceShard& rs) {
   sub.add_option("TABLE", tables, "han2012, halen2007, plante2001 or all; several may be named")
       ->type_name("NAME");
   sub.add_option("--frames", o.frames, "cap every run at N frames (quick runs), 1 to 1000000")
@@ -508,6 +631,7 @@ void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, Repr
       ->type_name("NAME|INDEX");
   sub.add_option("--out", o.out, "the report's directory")->type_name("DIR")->capture_default_str();
   sub.add_flag_callback("--no-charts", [&o] { o.charts = false; }, "no claim charts (reproduce.json, .md, .html only)");
+  add_shard_options(sub, rs.arg, rs.plan_only, nullptr, "paper");
 }
 
 // CLI11's parse errors in the project's one-line form, naming the argument and the
@@ -566,10 +690,15 @@ int run(int argc, char** argv) {
   CLI::App* stress = app.add_subcommand("stress", kStressHelp);
   add_stress_options(*stress, stress_args);
 
+  MergeArgs merge_args;
+  CLI::App* merge = app.add_subcommand("merge", kMergeHelp);
+  add_merge_options(*merge, merge_args);
+
   std::vector<std::string> tables;
   ReproduceOptions reproduce_opt;
+  ReproduceShard reproduce_shard;
   CLI::App* reproduce = app.add_subcommand("reproduce", kReproduceHelp);
-  add_reproduce_options(*reproduce, tables, reproduce_opt);
+  add_reproduce_options(*reproduce, tables, reproduce_opt, reproduce_shard);
 
   // Without arguments the usage is the answer, with the exit code of a bad command line;
   // `hairbench help` is a documented spelling of --help.
@@ -584,15 +713,17 @@ int run(int argc, char** argv) {
     throw argument_error(app, e);
   }
   if (list->parsed()) return cmd_list(list_what);
-  if (compare->parsed()) return cmd_compare(compare_args);
-  if (sweep->parsed()) return cmd_sweep(sweep_args);
+  if (compare->parsed()) return run_batches(compare_args, false);
+  if (sweep->parsed()) return run_batches(sweep_args, true);
+  if (merge->parsed()) return cmd_merge(merge_args);
   if (stress->parsed()) return cmd_stress(stress_args);
   if (reproduce->parsed()) {
     reproduce_opt.papers = select_papers(tables);
+    if (!shard_papers(reproduce_opt.papers, reproduce_shard)) return 0;
     return cmd_reproduce(reproduce_opt);
   }
   throw InputError("arguments", "hairbench",
-                   "name a subcommand: list, compare, sweep, stress or reproduce (see hairbench --help)");
+                   "name a subcommand: list, compare, sweep, stress, merge or reproduce (see hairbench --help)");
 }
 
 }  // namespace

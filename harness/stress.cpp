@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "harness/runner.h"
+#include "harness/shard.h"
 #include "reports/verdict.h"
 #include "models/registry.h"
 #include "scenarios/groom_gen.h"
@@ -203,8 +204,46 @@ std::pair<verdict::Status, std::string> run_one(const Scenario& sc, const std::s
 
 }  // namespace
 
-StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::function<void(int, int)>& progress) {
-  Scenario base = load_scenario(find_scenario(opt.base));
+std::string stress_cell_key(const std::string& model, const std::string& axis, double value) {
+  char v[32];
+  std::snprintf(v, sizeof v, "%.17g", value);
+  return model + "/" + axis + "=" + v;
+}
+
+std::string stress_groom_key(const std::string& model, const std::string& groom) { return model + "/groom:" + groom; }
+
+void decide_axis(StressAxisResult& a) {
+  a.last_stable.reset();
+  a.first_failing.reset();
+  a.reason.clear();
+  for (const StressCell& c : a.cells) {
+    if (!c.stable && !a.first_failing) {
+      a.first_failing = c.value;
+      a.reason = c.reason;
+    }
+    if (c.stable && !a.first_failing) a.last_stable = c.value;
+  }
+  if (!a.first_failing) a.last_stable.reset();  // "never failed" reads better than a value
+}
+
+namespace {
+
+// What a stress command runs: the thinned base, each model's selected axes with their
+// values, and the degenerate grooms.
+struct StressWork {
+  Scenario base;
+  struct Planned {
+    std::string model;
+    Axis axis;
+  };
+  std::vector<Planned> plan;
+  std::vector<Degenerate> degenerate;
+};
+
+StressWork prepare(const StressOptions& opt) {
+  StressWork w;
+  w.base = load_scenario(find_scenario(opt.base));
+  Scenario& base = w.base;
   if (base.follow)
     throw InputError(base.source.string(), "groom.follow_hairs",
                      "stress needs a base whose strands are all simulated (\"simulate\")");
@@ -215,18 +254,6 @@ StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::f
   } catch (const std::regex_error& e) {
     throw InputError("arguments", "--axes", std::string("bad regular expression: ") + e.what());
   }
-
-  StressResult result;
-  result.base = base.name;
-  result.strands = base.groom.strand_count();
-  result.vertices = base.groom.vertex_count();
-
-  // Plan first so progress can say how much is left.
-  struct Planned {
-    std::string model;
-    Axis axis;
-  };
-  std::vector<Planned> plan;
   for (const std::string& m : opt.models) {
     const ModelInfo* info = find_model(m);
     if (!info) throw InputError("--models", m, "unknown model");
@@ -239,20 +266,87 @@ StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::f
         if (kept.back() != a.values.back()) kept.push_back(a.values.back());  // keep the extreme
         a.values = std::move(kept);
       }
-      plan.push_back({m, std::move(a)});
+      w.plan.push_back({m, std::move(a)});
     }
   }
-  const std::vector<Degenerate> degenerate = opt.degenerate ? degenerate_grooms(base.head_radius)
-                                                            : std::vector<Degenerate>{};
-  int total = static_cast<int>(degenerate.size() * opt.models.size()), done = 0;
-  for (const Planned& p : plan) total += static_cast<int>(p.axis.values.size());
+  if (opt.degenerate) w.degenerate = degenerate_grooms(base.head_radius);
+  return w;
+}
+
+// The base with a degenerate groom in place of its own.
+Scenario with_groom(const Scenario& base, const Degenerate& d) {
+  Scenario sc = base;
+  sc.groom = d.groom;
+  sc.groom.head_radius = base.head_radius;
+  sc.region_params.assign(1, {});
+  for (auto& [model, o] : sc.models) o.regions.clear();
+  if (!d.colliders.empty()) sc.colliders = d.colliders;
+  return sc;
+}
+
+}  // namespace
+
+Plan plan_stress(const StressOptions& opt, const CostModel& costs, int count) {
+  const StressWork w = prepare(opt);
+  Plan plan;
+  plan.count = count;
+  plan.cost_source = costs.from_file() ? costs.file() : "the built-in table";
+  plan.process_seconds = kProcessSeconds;
+  // Each run is its own lockstep batch (the model is its own reference): no shared cost.
+  plan.group_cost = {0.0};
+  plan.group_label = {"each run alone"};
+  auto estimate = [&](const Scenario& sc, const std::string& model, const std::vector<ParamOverride>& o,
+                      const std::string& key) {
+    const ModelInfo& info = *find_model(model);
+    try {
+      return costs.run(info, resolve_params(info, sc, o), key, sc.groom.strand_count(), sc.groom.vertex_count(),
+                       sc.frames, work_fraction(sc, sc.frames));
+    } catch (const InputError&) {  // refused at load: it costs nothing
+      return CostEstimate{0.0, "refused"};
+    }
+  };
+  for (const StressWork::Planned& p : w.plan)
+    for (double v : p.axis.values) {
+      Scenario sc = w.base;
+      std::vector<ParamOverride> overrides;
+      p.axis.apply(sc, overrides, v);
+      const std::string key = stress_cell_key(p.model, p.axis.name, v);
+      char label[160];
+      std::snprintf(label, sizeof label, "%s %s=%g", p.model.c_str(), p.axis.name.c_str(), v);
+      plan.items.push_back({key, label, 0, estimate(sc, p.model, overrides, key), 0});
+    }
+  for (const std::string& m : opt.models)
+    for (const Degenerate& d : w.degenerate) {
+      const std::string key = stress_groom_key(m, d.name);
+      plan.items.push_back({key, m + " groom:" + d.name, 0, estimate(with_groom(w.base, d), m, {}, key), 0});
+    }
+  partition(plan);
+  return plan;
+}
+
+StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::function<void(int, int)>& progress) {
+  const StressWork w = prepare(opt);
+  const Scenario& base = w.base;
+  StressResult result;
+  result.base = base.name;
+  result.base_hash = scenario_hash(base, base.frames);
+  result.strands = base.groom.strand_count();
+  result.vertices = base.groom.vertex_count();
+
+  auto wanted = [&](const std::string& key) { return !opt.only || opt.only->count(key); };
+  int total = 0, done = 0;
+  for (const StressWork::Planned& p : w.plan)
+    for (double v : p.axis.values) total += wanted(stress_cell_key(p.model, p.axis.name, v));
+  for (const std::string& m : opt.models)
+    for (const Degenerate& d : w.degenerate) total += wanted(stress_groom_key(m, d.name));
   auto tick = [&] {
     if (progress) progress(++done, total);
   };
 
-  for (const Planned& p : plan) {
+  for (const StressWork::Planned& p : w.plan) {
     StressAxisResult ar{p.model, p.axis.name, p.axis.unit, {}, {}, {}, {}};
     for (double v : p.axis.values) {
+      if (!wanted(stress_cell_key(p.model, p.axis.name, v))) continue;
       Scenario sc = base;
       std::vector<ParamOverride> overrides;
       p.axis.apply(sc, overrides, v);
@@ -263,27 +357,19 @@ StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::f
         cell.reason = std::string("refused: ") + e.what();
       }
       cell.stable = cell.reason.empty();
-      if (!cell.stable && !ar.first_failing) {
-        ar.first_failing = v;
-        ar.reason = cell.reason;
-      }
-      if (cell.stable && !ar.first_failing) ar.last_stable = v;
       ar.cells.push_back(std::move(cell));
       tick();
     }
-    if (!ar.first_failing) ar.last_stable.reset();  // "never failed" reads better than a value
+    if (ar.cells.empty()) continue;
+    decide_axis(ar);
     result.axes.push_back(std::move(ar));
   }
 
   for (const std::string& m : opt.models)
-    for (const Degenerate& d : degenerate) {
+    for (const Degenerate& d : w.degenerate) {
+      if (!wanted(stress_groom_key(m, d.name))) continue;
       DegenerateResult dr{m, d.name, "ok", {}};
-      Scenario sc = base;
-      sc.groom = d.groom;
-      sc.groom.head_radius = base.head_radius;
-      sc.region_params.assign(1, {});
-      for (auto& [model, o] : sc.models) o.regions.clear();
-      if (!d.colliders.empty()) sc.colliders = d.colliders;
+      const Scenario sc = with_groom(base, d);
       try {
         validate_groom(sc.groom, "stress: degenerate groom '" + d.name + "'");
         const auto [status, why] = run_one(sc, m, {}, pool);
@@ -327,6 +413,7 @@ nlohmann::json stress_json(const StressResult& r) {
                           {"status", d.status},
                           {"reason", d.reason.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.reason)}});
   return {{"base", r.base},
+          {"base_hash", r.base_hash},
           {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
           {"failure_criteria",
            "any verdict but ok (docs/verdicts.md): diverged (NaN/Inf; a vertex farther than 10 mean strand "

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -44,14 +45,33 @@ struct StressOptions {
   int value_stride = 1;         // > 1 keeps every n-th value of each axis (quick runs)
   std::string axes = ".*";      // regex over axis names
   bool degenerate = true;
+  // When set, only the cells and degenerate grooms with these keys run (a shard's part,
+  // stress_cell_key and stress_groom_key); the result holds only them.
+  std::optional<std::set<std::string>> only;
 };
 
 struct StressResult {
   std::string base;
+  std::string base_hash;  // the thinned base scenario (scenario_hash): shards must share it
   std::size_t strands = 0, vertices = 0;
   std::vector<StressAxisResult> axes;
   std::vector<DegenerateResult> degenerate;
 };
+
+// The keys of one stress run in a plan and a shard report: "MODEL/AXIS=VALUE" (the value
+// as %.17g) and "MODEL/groom:NAME".
+std::string stress_cell_key(const std::string& model, const std::string& axis, double value);
+std::string stress_groom_key(const std::string& model, const std::string& groom);
+
+// Sets an axis's last_stable, first_failing and reason from its cells, in escalation
+// order.
+void decide_axis(StressAxisResult& axis);
+
+struct Plan;
+class CostModel;
+// Every run of the stress command, in the order it runs them, with its estimated cost
+// (each runs the model alone, as its own reference), cut into `count` shards.
+Plan plan_stress(const StressOptions& options, const CostModel& costs, int count);
 
 // progress(done, total) after each run.
 StressResult run_stress(const StressOptions& options, ThreadPool& pool,

@@ -130,6 +130,38 @@ def asleep(run):
     return math.isfinite(t) and t < 1e-4
 
 
+def machine_of(report):
+    """Run -> index of the machine that timed it, in a report merged from shards
+    (hairbench merge); None in a report of one process."""
+    shards = {sh["index"]: sh["machine"] for sh in (report.get("merge") or {}).get("shards", [])}
+    return lambda run: shards.get(run.get("shard"))
+
+
+def machine_groups(report, runs):
+    """The runs split by the machine that timed them, [(label, runs)], so that no chart
+    compares times from two machines; one group (label None) for a report of one machine,
+    or when the merge was told --mix-machines (then mixed_note marks it)."""
+    merge = report.get("merge") or {}
+    if len(merge.get("machines", [])) < 2 or merge.get("mix_machines"):
+        return [(None, runs)]
+    which = machine_of(report)
+    groups = {}
+    for r in runs:
+        groups.setdefault(which(r), []).append(r)
+    return [(f"timed on machine {m + 1}: {merge['machines'][m]}", rs) for m, rs in sorted(groups.items())]
+
+
+def mixed_note(report, runs):
+    """With --mix-machines, where the runs' times come from more than one machine: the
+    mark a chart carries."""
+    merge = report.get("merge") or {}
+    which = machine_of(report)
+    machines = {which(r) for r in runs}
+    if merge.get("mix_machines") and len(machines) > 1:
+        return f"times from {len(machines)} machines mixed (--mix-machines)"
+    return None
+
+
 def scenario_names(report):
     names = []
     for r in report["runs"]:
@@ -231,13 +263,22 @@ def pareto_front(points):
 
 # --- run time vs error ------------------------------------------------------------------
 
+def machine_panels(report):
+    """(scenario, machine label, runs) per chart panel: a scenario's runs, split by the
+    machine that timed them (machine_groups)."""
+    out = []
+    for name in scenario_names(report):
+        for label, runs in machine_groups(report, [r for r in report["runs"] if r["scenario"] == name]):
+            out.append((name, label, runs))
+    return out
+
+
 def chart_time_vs_error(report, out_dir, stem, written, svg):
-    names = scenario_names(report)
     colours = model_colours(report)
-    fig, axes = grid(len(names))
+    split = machine_panels(report)
+    fig, axes = grid(len(split))
     panels = []
-    for ax, name in zip(axes, names):
-        runs = [r for r in report["runs"] if r["scenario"] == name]
+    for ax, (name, machine, runs) in zip(axes, split):
         # Every run that went to the end is drawn; a stretched or unstable one is marked (its
         # numbers are real, its behaviour is not what the method promises). A run that
         # diverged has no comparable numbers and is named in the corner.
@@ -299,6 +340,13 @@ def chart_time_vs_error(report, out_dir, stem, written, svg):
         ax.set_ylabel("median step time (ms)")
         knob = next((r["knob"]["name"] for r in runs if "knob" in r), None)
         title = f"{name}: run time vs error" + (f" over {knob}" if knob else "")
+        mixed = mixed_note(report, runs)
+        if machine:
+            title += "\n" + textwrap.shorten(machine, 70)
+        if mixed:
+            title += "\n" + mixed
+            ax.text(0.99, 0.99, "times from different machines", transform=ax.transAxes, fontsize=7,
+                    color="tab:red", ha="right", va="top")
         ax.set_title(title + f"\nreference {reference_text(runs[0])}", fontsize=9)
         if stopped:
             ax.text(0.01, 0.01, "diverged: " + ", ".join(stopped), transform=ax.transAxes, fontsize=7,
@@ -307,6 +355,8 @@ def chart_time_vs_error(report, out_dir, stem, written, svg):
         ax.legend(fontsize=7)
         panels.append({
             "scenario": name,
+            "machine": machine,
+            "mixed_machines": bool(mixed),
             "series": series,
             "pareto": [{"model": r["model"], "knob": r.get("knob"), "step_ms": t, "deviation": e}
                        for t, e, r in front],
@@ -391,12 +441,11 @@ def stage_colours(report):
 
 
 def chart_stages(report, out_dir, stem, written, svg):
-    names = scenario_names(report)
-    fig, axes = grid(len(names), ncols_max=2, w=7.5, h=4.2)
+    split = machine_panels(report)
+    fig, axes = grid(len(split), ncols_max=2, w=7.5, h=4.2)
     all_stages, stage_colour = stage_colours(report)
     panels = []
-    for ax, name in zip(axes, names):
-        runs = [r for r in report["runs"] if r["scenario"] == name]
+    for ax, (name, machine, runs) in zip(axes, split):
         labels = [run_label(r) for r in runs]
         bottom = [0.0] * len(runs)
         segments = []
@@ -438,9 +487,11 @@ def chart_stages(report, out_dir, stem, written, svg):
         ax.set_xticks(range(len(runs)))
         ax.set_xticklabels(labels, rotation=90, fontsize=7)
         ax.set_ylabel("ms per step (mean)")
-        ax.set_title(f"{name}: time per solver stage", fontsize=9)
+        mixed = mixed_note(report, runs)
+        ax.set_title(f"{name}: time per solver stage" + (f"\n{textwrap.shorten(machine, 80)}" if machine else "")
+                     + (f"\n{mixed}" if mixed else ""), fontsize=9, color="tab:red" if mixed else "black")
         ax.grid(True, axis="y", alpha=0.25)
-        panels.append({"scenario": name, "bars": len(runs), "stages": segments, "runs_with_skipped": len(skipped_lines),
+        panels.append({"scenario": name, "machine": machine, "mixed_machines": bool(mixed), "bars": len(runs), "stages": segments, "runs_with_skipped": len(skipped_lines),
                        "colours": {s: matplotlib.colors.to_hex(stage_colour[s]) for s in segments}})
     fig.tight_layout()
     return {"files": save(fig, out_dir, stem, "stages", written, svg), "panels": panels}
@@ -626,6 +677,14 @@ def scenario_notes(report, name):
     runs = [r for r in report["runs"] if r["scenario"] == name]
     notes.append(f"reference: {reference_text(runs[0])}; {runs[0]['groom']['strands']} strands, "
                  f"{runs[0]['groom']['vertices']} vertices, {runs[0]['frames']} frames")
+    merge = report.get("merge") or {}
+    if len(merge.get("machines", [])) > 1:
+        which = machine_of(report)
+        by = {}
+        for r in runs:
+            by.setdefault(which(r), []).append(run_label(r))
+        notes.append("timed on " + "; ".join(f"machine {m + 1} ({merge['machines'][m]}): {', '.join(labels)}"
+                                            for m, labels in sorted(by.items())))
     if info:
         phases = "; ".join(f"{p['start']:.2f}–{p['end']:.2f} s {p['label']}" for p in info.get("phases", []))
         notes.append("phases: " + (phases or "none (the head holds still)"))
@@ -653,6 +712,13 @@ def context_line(report):
             f"{c.get('threads', '?')} threads · {c.get('build_type', '?')} · {c.get('compiler', '?')}")
     for d in c.get("devices", []):
         line += f" · GPU {device_text(d)}"
+    merge = report.get("merge")
+    if merge:
+        line += (f" · merged from {len(merge['shards'])} shards on {len(merge['machines'])} machine"
+                 f"{'s' if len(merge['machines']) != 1 else ''}: "
+                 + "; ".join(f"machine {i + 1}: {m}" for i, m in enumerate(merge["machines"]))
+                 + (" · times from different machines are compared (--mix-machines)"
+                    if merge.get("mix_machines") and len(merge["machines"]) > 1 else ""))
     return line
 
 
@@ -685,6 +751,7 @@ def overview(report):
     that scenario, its deviation and its jaggedness."""
     names = scenario_names(report)
     rows = list(dict.fromkeys(run_label(r) for r in report["runs"]))
+    which = machine_of(report)
     cells = {}
     for name in names:
         runs = [r for r in report["runs"] if r["scenario"] == name]
@@ -695,11 +762,16 @@ def overview(report):
         ref_t = num(ref_run["timing"]["step_ms"]["median"]) if ref_run else float("nan")
         for r in runs:
             t = num(r["timing"]["step_ms"]["median"])
+            # A time over one from another machine is no ratio, unless the merge was
+            # told --mix-machines; then the cell says so.
+            other = ref_run is not None and which(r) != which(ref_run)
+            mix = (report.get("merge") or {}).get("mix_machines", False)
             cells[(run_label(r), name)] = {
                 "status": r["status"],
                 "verdict": verdict_text(r),
                 "asleep": asleep(r),
-                "speed": t / ref_t if ref_t > 0 and math.isfinite(t) else float("nan"),
+                "other_machine": other,
+                "speed": t / ref_t if ref_t > 0 and math.isfinite(t) and (mix or not other) else float("nan"),
                 "deviation": num(r["metrics"]["deviation_vs_reference"]["rms"]),
                 "jaggedness": num(r["metrics"]["jaggedness"]["mean"]),
             }
@@ -744,6 +816,8 @@ def overview_html(report):
             verdict = "asleep" if c["status"] == "ok" and c["asleep"] else c["verdict"]
             v = c["speed"]
             speed = "–" if not math.isfinite(v) else f"×{v:.0f}" if v >= 10 else f"×{v:.2g}"
+            if c["other_machine"]:
+                speed += " (other machines)" if math.isfinite(v) else " (timed on another machine)"
             tds.append(f"<td style='background:{cell_colour(c)}'><b>{e(verdict)}</b><br>{e(speed)}<br>"
                        f"dev {e(fmt(c['deviation'], '.2g'))}<br>jag {e(fmt(c['jaggedness'], '.2g'))}</td>")
         out.append("<tr>" + "".join(tds) + "</tr>")
@@ -813,7 +887,9 @@ def main(argv):
     except ReportError as e:
         print(f"charts.py: {args.report}: {e}", file=sys.stderr)
         return 2
-    pareto = {p["scenario"]: p["pareto"] for p in charts["time_vs_error"]["panels"]}
+    pareto = {}
+    for p in charts["time_vs_error"]["panels"]:
+        pareto.setdefault(p["scenario"], []).extend(p["pareto"])
     md = os.path.join(out_dir, f"{stem}_summary.md")
     write_markdown(report, md, pareto)
     page = os.path.join(out_dir, f"{stem}.html")

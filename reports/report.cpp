@@ -361,6 +361,7 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
           {"duration", sc.frames * sc.dt},
           {"mean_strand_length", sc.mean_strand_length},
           {"head_radius", sc.head_radius},
+          {"definition_hash", sc.definition_hash},
           {"phases", std::move(phases)},
           {"snapshots",
            {{"criterion", "most_violent: the frame where the reference's kinetic energy per unit mass relative to "
@@ -368,7 +369,8 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
                           "highest (hair moving rigidly with the head is still); final: the last frame"},
             {"strands", sc.snapshot_strands},
             {"frames", std::move(frames)},
-            {"reference", {{"model", sc.reference}, {"snapshots", std::move(ref)}}}}}};
+            {"reference", {{"model", sc.reference}, {"snapshots", std::move(ref)}}}}},
+          {"reference_state_hash", metrics::hash_hex(sc.reference_state_hash)}};
 }
 
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,

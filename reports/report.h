@@ -107,6 +107,12 @@ struct ScenarioRecord {
   std::vector<SnapshotFrame> snapshot_frames;
   std::string reference;
   std::vector<RunRecord::Snapshot> reference_snapshots;
+  // The reference's final positions (metrics::state_hash): every shard of a sweep runs
+  // the reference itself, and hairbench merge checks that they all got the same bits.
+  std::uint64_t reference_state_hash = 0;
+  // The resolved scenario with the command's --set, --frames and reference
+  // (harness/runner.h, scenario_hash), 16 hex digits.
+  std::string definition_hash;
 };
 
 inline constexpr std::size_t kMaxSnapshotStrands = 200;

@@ -73,7 +73,8 @@ TEST(Cli, VersionNamesTheBuiltCommit) {
 // 0, naming every option of that subcommand and none that only another one takes.
 TEST(Cli, HelpNamesEveryOption) {
   const std::vector<std::string> run_options = {"--scenario", "--models",  "--reference", "--frames", "--threads",
-                                                "--set",      "--out",     "--no-charts", "--device", "--no-skip"};
+                                                "--set",      "--out",     "--no-charts", "--device", "--no-skip",
+                                                "--shard",    "--plan",    "--costs"};
   std::vector<std::string> sweep_options = run_options;
   sweep_options.push_back("--knob");
   struct Help {
@@ -81,16 +82,18 @@ TEST(Cli, HelpNamesEveryOption) {
     std::vector<std::string> names, absent;
   };
   const std::vector<Help> cases = {
-      {"", {"--help", "--version", "list", "compare", "sweep", "stress", "reproduce"}, {"--frames"}},
+      {"", {"--help", "--version", "list", "compare", "sweep", "stress", "merge", "reproduce"}, {"--frames"}},
       {"list", {"--help", "models|scenarios|devices"}, {"--out"}},
       {"compare", run_options, {"--knob", "--quick"}},
       {"sweep", sweep_options, {"--quick", "--keep-every"}},
       {"stress",
-       {"--models", "--base", "--axes", "--keep-every", "--quick", "--threads", "--out", "--no-charts"},
+       {"--models", "--base", "--axes", "--keep-every", "--quick", "--threads", "--out", "--no-charts", "--shard",
+        "--plan", "--costs"},
        {"--scenario", "--set", "--knob"}},
+      {"merge", {"OUT_DIR", "REPORT.json", "--mix-machines", "--no-charts"}, {"--frames", "--models", "--costs"}},
       {"reproduce",
-       {"han2012", "halen2007", "plante2001", "all", "--frames", "--threads", "--device", "--out"},
-       {"--models", "--set"}}};
+       {"han2012", "halen2007", "plante2001", "all", "--frames", "--threads", "--device", "--out", "--shard", "--plan"},
+       {"--models", "--set", "--costs"}}};
   for (const Help& h : cases)
     for (const char* flag : {"--help", "-h"}) {
       const std::string args = h.sub + " " + flag;
