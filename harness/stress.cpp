@@ -205,6 +205,9 @@ std::pair<verdict::Status, std::string> run_one(const Scenario& sc, const std::s
 
 StressResult run_stress(const StressOptions& opt, ThreadPool& pool, const std::function<void(int, int)>& progress) {
   Scenario base = load_scenario(find_scenario(opt.base));
+  // Each axis escalates a model at its own substeps: picked from the groom, they would
+  // follow the time step and strand axes instead of meeting them.
+  base.auto_substeps = false;
   if (base.follow)
     throw InputError(base.source.string(), "groom.follow_hairs",
                      "stress needs a base whose strands are all simulated (\"simulate\")");
