@@ -531,6 +531,27 @@ void LockstepRun::record_scenario(int frames) const {
   out.dt = sc_.dt;
   out.mean_strand_length = rest_.mean_strand_length;
   out.head_radius = sc_.groom.head_radius;
+  if (sc_.import) {
+    const GroomImport& im = *sc_.import;
+    nlohmann::json repairs = nlohmann::json::array();
+    for (const Repair& r : im.repairs)
+      repairs.push_back({{"kind", r.kind}, {"strands", r.strands}, {"items", r.items}, {"action", r.action},
+                         {"first", r.example}});
+    out.groom = {{"file", im.file.string()},
+                 {"unit", im.unit},
+                 {"unit_from", im.unit_from},
+                 {"pivot", {im.pivot.x(), im.pivot.y(), im.pivot.z()}},
+                 {"pivot_from", im.pivot_from},
+                 {"head_radius_fit", im.head_radius_fit},
+                 {"degenerate", im.degenerate},
+                 {"repairs", std::move(repairs)}};
+    if (im.fitted)
+      out.groom["fit"] = {{"sphere", im.fit.sphere},
+                          {"center_m", {im.fit.center.x(), im.fit.center.y(), im.fit.center.z()}},
+                          {"radius_m", im.fit.radius},
+                          {"rms_residual_m", im.fit.rms_residual},
+                          {"note", im.fit.note}};
+  }
   out.phases.clear();
   for (const Phase& p : scenario_phases(sc_, frames * sc_.dt)) out.phases.push_back({p.start, p.end, p.kind, p.label});
   out.snapshot_strands = snap_strands_;

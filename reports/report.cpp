@@ -366,7 +366,7 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
   }
   nlohmann::json ref = nlohmann::json::array();
   for (const auto& snap : sc.reference_snapshots) ref.push_back(snapshot_json(snap));
-  return {{"name", sc.name},
+  nlohmann::json out = {{"name", sc.name},
           {"frames", sc.frames},
           {"dt", sc.dt},
           {"duration", sc.frames * sc.dt},
@@ -380,6 +380,8 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
             {"strands", sc.snapshot_strands},
             {"frames", std::move(frames)},
             {"reference", {{"model", sc.reference}, {"snapshots", std::move(ref)}}}}}};
+  if (!sc.groom.is_null()) out["groom"] = sc.groom;
+  return out;
 }
 
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,

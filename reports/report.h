@@ -95,6 +95,8 @@ struct ScenarioRecord {
   double dt = 0.0;
   double mean_strand_length = 0.0;  // L-bar, metres: per-vertex deviation is |p - p_ref| / L-bar
   double head_radius = 0.0;
+  // An imported groom: its file, unit, pivot, fitted head and repairs (null otherwise).
+  nlohmann::json groom;
   struct PhaseSpan {
     double start, end;
     std::string kind, label;
