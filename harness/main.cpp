@@ -14,6 +14,7 @@
 #include "harness/stress.h"
 #include "models/registry.h"
 #include "reports/report.h"
+#include "scenarios/groom_scenario.h"
 #include "scenarios/scenario.h"
 #ifdef HAIRBENCH_HAS_VULKAN
 #include "kernels/vulkan/runtime.h"
@@ -26,6 +27,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <regex>
 #include <set>
@@ -87,6 +90,12 @@ constexpr const char* kReproduceHelp =
     "testable, each with the paper's sentence) and measurements\n"
     "(hardware-dependent numbers beside the paper's, no verdict).";
 
+constexpr const char* kScenarioHelp =
+    "scenario new writes the scenario that compare --groom runs:\n"
+    "a TressFX groom under a built-in motion, with the unit, the\n"
+    "pivot, the head sphere and its collider fitted, as a file to\n"
+    "edit.";
+
 struct KnobSpec {
   std::string name;
   std::vector<double> values;
@@ -105,6 +114,11 @@ struct CompareArgs {
   std::string shard_arg;  // --shard I/N
   bool plan_only = false;  // --plan
   std::string costs;       // --costs REPORT.json
+  // compare --groom: a TressFX groom under built-in motions instead of scenarios.
+  std::string groom;
+  std::vector<std::string> motions;
+  std::string unit = "auto";
+  std::optional<double> fit_above;
   // Resolved by prepare_compare.
   ShardSpec shard;
   CostModel cost_model;
@@ -237,6 +251,15 @@ void print_run(const nlohmann::json& r) {
     std::printf("  %-14s gpu %s ms back to back at %s MHz, %s ms in lockstep\n", "",
                 f(t["gpu_ms"]["median"], "%.4f").c_str(), f(t["gpu_clock_mhz"], "%.0f").c_str(),
                 t.contains("gpu_ms_lockstep") ? f(t["gpu_ms_lockstep"]["median"], "%.4f").c_str() : "-");
+  // Substeps picked from the groom, and the bound that decided them.
+  if (r.contains("substeps") && r["substeps"]["source"] == "auto") {
+    const auto& c = r["substeps"];
+    if (c["capped"].get<bool>())
+      std::printf("  %-14s substeps %d (auto, capped: the bound asks for %d or more; %s)\n", "", c["value"].get<int>(),
+                  c["needed"].get<int>(), c["bound"].get<std::string>().c_str());
+    else
+      std::printf("  %-14s substeps %d (auto; %s)\n", "", c["value"].get<int>(), c["bound"].get<std::string>().c_str());
+  }
   // Every class but ok says why, and where it was decided.
   const auto& v = r["verdict"];
   if (v["class"] != "ok") {
@@ -285,6 +308,30 @@ int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<Devic
   return a.charts ? draw_charts(out) : 0;
 }
 
+// Where compare --groom's time goes (printed once the runs are done).
+struct GroomTimes {
+  double load_s = 0.0, fit_s = 0.0;
+};
+
+// compare --groom: the groom is read, repaired and fitted once, then put under each motion.
+std::vector<Scenario> load_groom_scenarios(const CompareArgs& a, GroomTimes& times) {
+  const std::filesystem::path groom = std::filesystem::absolute(a.groom);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(groom, ec)) throw InputError("--groom", a.groom, "no such file");
+  const std::vector<std::string> motions = a.motions.empty() ? default_motions() : a.motions;
+  const nlohmann::json doc = groom_scenario_json(groom, groom.string(), motions.front(), a.unit, a.fit_above);
+  const auto start = std::chrono::steady_clock::now();
+  const Scenario base =
+      load_scenario_text(doc.dump(), std::filesystem::current_path() / (doc["name"].get<std::string>() + ".json"));
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  times.fit_s = base.import->seconds_fit;
+  times.load_s = total - times.fit_s;
+  std::fputs(import_summary(base).c_str(), stdout);
+  std::vector<Scenario> scenarios;
+  for (const std::string& m : motions) scenarios.push_back(with_motion(base, m));
+  return scenarios;
+}
+
 std::vector<Scenario> load_scenarios(const CompareArgs& a) {
   // Load every scenario before running any, so a bad file fails fast.
   std::vector<Scenario> scenarios;
@@ -299,12 +346,43 @@ void print_header(const Scenario& sc, const CompareArgs& a) {
               sc.groom.vertex_count(), a.run.frames > 0 ? a.run.frames : sc.frames);
 }
 
+// scenario new: the scenario compare --groom runs for one motion, as a file, with the
+// groom's path relative to it and the unit resolved.
+int cmd_scenario_new(const std::string& groom_arg, const std::string& motion, const std::string& unit,
+                     std::optional<double> fit_above, const std::string& out_arg) {
+  namespace fs = std::filesystem;
+  const fs::path groom = fs::absolute(groom_arg), out = fs::absolute(out_arg);
+  std::error_code ec;
+  if (!fs::is_regular_file(groom, ec)) throw InputError("--groom", groom_arg, "no such file");
+  if (out.extension() != ".json") throw InputError("--out", out_arg, "expected a .json file name");
+  if (!fs::is_directory(out.parent_path(), ec)) throw InputError("--out", out_arg, "no such folder");
+  nlohmann::json doc =
+      groom_scenario_json(groom, fs::relative(groom, out.parent_path()).generic_string(), motion, unit, fit_above);
+  // Loaded before it is written, so that a groom that cannot run leaves no file behind.
+  const Scenario sc = load_scenario_text(doc.dump(), out);
+  doc["groom"]["unit"] = sc.import->unit;
+  std::ofstream file(out);
+  file << doc.dump(2) << "\n";
+  if (!file) throw InputError(out.string(), "file", "cannot be written");
+  std::fputs(import_summary(sc).c_str(), stdout);
+  std::printf("wrote %s\n", out.string().c_str());
+  return 0;
+}
+
 // compare and sweep: per scenario, one lockstep batch per knob value (one batch without
 // a knob), each running the plan's models of this shard (every model unsharded) beside
 // the reference, which every batch runs for itself.
 int run_batches(CompareArgs& a, bool sweep) {
   prepare_compare(a, sweep);
-  const std::vector<Scenario> scenarios = load_scenarios(a);
+  if (!a.groom.empty() && !a.scenarios.empty())
+    throw InputError("arguments", "--groom", "give either --groom or --scenario, not both");
+  if (a.groom.empty() && !a.motions.empty()) throw InputError("arguments", "--motion", "applies to --groom only");
+  if (a.groom.empty() && a.unit != "auto") throw InputError("arguments", "--unit", "applies to --groom only");
+  if (a.groom.empty() && a.fit_above) throw InputError("arguments", "--fit-above", "applies to --groom only");
+  GroomTimes groom_times;
+  const std::vector<Scenario> scenarios = a.groom.empty() ? load_scenarios(a) : load_groom_scenarios(a, groom_times);
+  if (!a.groom.empty())
+    for (const std::string& why : a.skipped) std::fprintf(stderr, "hairbench: skipped model %s\n", why.c_str());
   const std::vector<double> values = a.knob ? a.knob->values : std::vector<double>{};
   const std::string knob_name = a.knob ? a.knob->name : "";
   const Plan plan = plan_runs(scenarios, a.run, knob_name, values, a.cost_model, a.shard.active() ? a.shard.count : 1);
@@ -317,6 +395,7 @@ int run_batches(CompareArgs& a, bool sweep) {
   int total = 0;
   for (const PlanItem& it : plan.items) total += it.shard == mine;
 
+  double models_s = 0.0, runs_s = 0.0;
   ThreadPool pool(a.threads);
   Progress progress(total, true);
   std::vector<RunRecord> runs;
@@ -347,13 +426,23 @@ int run_batches(CompareArgs& a, bool sweep) {
       }
       opt.on_frame = [&](int done, int frames) { progress.frame(done, frames); };
       progress.begin(static_cast<int>(opt.models.size()), what);
+      const auto start = std::chrono::steady_clock::now();
       std::vector<RunRecord> got = run_scenario(sc, opt, pool);
+      runs_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       progress.end();
-      for (const RunRecord& r : got) print_run(run_json(r));
+      for (const RunRecord& r : got) {
+        print_run(run_json(r));
+        for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
+      }
       std::fflush(stdout);
       for (RunRecord& r : got) runs.push_back(std::move(r));
     }
   }
+  // Stepping the models is what a comparison measures; the rest is overhead.
+  if (!a.groom.empty())
+    std::printf("time: load %.3f s (read, repairs, follow hairs), fit %.3f s (unit, head sphere, collider), "
+                "model steps %.3f s, metrics, probes and verdicts %.3f s\n",
+                groom_times.load_s, groom_times.fit_s, models_s, runs_s - models_s);
   nlohmann::json sweep_json;
   if (a.knob) sweep_json = {{"knob", knob_name}, {"values", values}, {"models", a.run.models}};
   return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan);
@@ -560,8 +649,38 @@ void add_merge_options(CLI::App& sub, MergeArgs& a) {
 }
 
 // The options compare and sweep share; sweep adds --knob and needs --scenario.
+// --unit and --fit-above for a TressFX groom: the unit given or guessed from its size, and
+// the height above which roots are on the head.
+void add_groom_fit_options(CLI::App& sub, std::string& unit, std::optional<double>& fit_above) {
+  sub.add_option("--fit-above", fit_above,
+                 "fit the head sphere through the roots higher than Y (file\n"
+                 "units) only, for roots that run past the scalp")
+      ->type_name("Y");
+  sub.add_option("--unit", unit, "the groom's unit: cm, mm, m, or auto (guessed from its\nsize)")
+      ->type_name("cm|mm|m|auto")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            return v == "cm" || v == "mm" || v == "m" || v == "auto" ? "" : "'" + v + "' is not cm, mm, m or auto";
+          },
+          ""));
+}
+
 void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
   a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
+  if (!sweep) {
+    sub.add_option("--groom", a.groom,
+                   "a TressFX groom (.tfx or .tfxproj) to run under built-in\n"
+                   "motions instead of scenarios, with its unit, pivot, head\n"
+                   "and collider fitted")
+        ->type_name("PATH");
+    sub.add_option("--motion", a.motions,
+                   "with --groom: a built-in scenario's head motion; repeatable\n"
+                   "(default: idle, nod, shake, spin_fast, walk, wind_gust)")
+        ->type_name("NAME")
+        ->allow_extra_args(false);
+    add_groom_fit_options(sub, a.unit, a.fit_above);
+  }
   sub.add_option("--scenario", a.scenarios,
                  sweep ? "built-in scenario or scenario file; repeatable"
                        : "built-in scenario or scenario file; repeatable\n(default: every built-in scenario)")
@@ -693,6 +812,17 @@ int run(int argc, char** argv) {
   MergeArgs merge_args;
   CLI::App* merge = app.add_subcommand("merge", kMergeHelp);
   add_merge_options(*merge, merge_args);
+  CLI::App* scenario = app.add_subcommand("scenario", kScenarioHelp);
+  scenario->require_subcommand(1);
+  std::string new_groom, new_motion = "shake", new_unit = "auto", new_out;
+  CLI::App* scenario_new = scenario->add_subcommand("new", kScenarioHelp);
+  scenario_new->add_option("--groom", new_groom, "a TressFX groom, .tfx or .tfxproj")->type_name("PATH")->required();
+  scenario_new->add_option("--motion", new_motion, "the built-in scenario whose head motion it takes")
+      ->type_name("NAME")
+      ->capture_default_str();
+  std::optional<double> new_fit_above;
+  add_groom_fit_options(*scenario_new, new_unit, new_fit_above);
+  scenario_new->add_option("--out", new_out, "the scenario file to write")->type_name("FILE.json")->required();
 
   std::vector<std::string> tables;
   ReproduceOptions reproduce_opt;
@@ -717,13 +847,14 @@ int run(int argc, char** argv) {
   if (sweep->parsed()) return run_batches(sweep_args, true);
   if (merge->parsed()) return cmd_merge(merge_args);
   if (stress->parsed()) return cmd_stress(stress_args);
+  if (scenario_new->parsed()) return cmd_scenario_new(new_groom, new_motion, new_unit, new_fit_above, new_out);
   if (reproduce->parsed()) {
     reproduce_opt.papers = select_papers(tables);
     if (!shard_papers(reproduce_opt.papers, reproduce_shard)) return 0;
     return cmd_reproduce(reproduce_opt);
   }
   throw InputError("arguments", "hairbench",
-                   "name a subcommand: list, compare, sweep, stress, merge or reproduce (see hairbench --help)");
+                   "name a subcommand: list, compare, sweep, stress, merge, reproduce or scenario (see hairbench --help)");
 }
 
 }  // namespace

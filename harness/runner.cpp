@@ -126,7 +126,54 @@ ParamSet resolve_params(const ModelInfo& model, const Scenario& sc, const std::v
     if (o.model == "*" && set.has(o.name)) set.set_everywhere(o.name, o.value, {"--set", "*."});
   for (const ParamOverride& o : overrides)
     if (o.model == model.name) set.set_everywhere(o.name, o.value, {"--set", o.model + "."});
+  if (const auto c = choose_substeps(model, sc, set, overrides); c && c->source == "auto")
+    set.set_everywhere("substeps", c->value, {sc.source.string(), "substeps (auto)."});
   return set;
+}
+
+std::optional<SubstepsChoice> choose_substeps(const ModelInfo& model, const Scenario& sc, const ParamSet& resolved,
+                                              const std::vector<ParamOverride>& overrides) {
+  if (!model.step_bound || !resolved.has("substeps")) return std::nullopt;
+  bool given = false, asked = false;
+  for (const ParamOverride& o : overrides) given |= o.name == "substeps" && (o.model == "*" || o.model == model.name);
+  for (const std::string key : {std::string("*"), std::string(model.name)}) {
+    const auto it = sc.models.find(key);
+    if (it == sc.models.end()) continue;
+    given |= it->second.base.contains("substeps");
+    asked |= it->second.substeps_auto;
+    for (const auto& [region, values] : it->second.regions) given |= values.contains("substeps");
+  }
+  SubstepsChoice c;
+  const ParamSpec* spec = nullptr;
+  for (const ParamSpec& p : model.params)
+    if (p.name == "substeps") spec = &p;
+  if (given || !(sc.auto_substeps || asked)) {
+    c.value = resolved.get_int("substeps");
+    c.source = given ? "given" : "default";
+    return c;
+  }
+  const Groom& simulated = sc.follow ? sc.guides : sc.groom;
+  const halen::StepBound bound = model.step_bound(simulated, resolved, sc.gravity);
+  c.source = "auto";
+  c.max_step = bound.max_step;
+  c.why = bound.why;
+  const double needed = bound.max_step > 0.0 ? std::ceil(sc.dt / bound.max_step) : spec->max + 1;
+  c.needed = static_cast<int>(std::min(needed, spec->max + 1));
+  c.value = std::max(static_cast<int>(spec->default_value), c.needed);
+  c.capped = c.value > spec->max;
+  if (c.capped) c.value = static_cast<int>(spec->max);
+  return c;
+}
+
+nlohmann::json substeps_json(const SubstepsChoice& c) {
+  nlohmann::json j = {{"value", c.value}, {"source", c.source}};
+  if (c.source == "auto") {
+    j["needed"] = c.needed;
+    j["max_step_s"] = c.max_step;
+    j["bound"] = c.why;
+    j["capped"] = c.capped;
+  }
+  return j;
 }
 
 namespace {
@@ -198,7 +245,8 @@ class LockstepRun {
 
  private:
   void make_lanes();
-  void add_lane(const ModelInfo* info, const ParamSet& params, bool reported);
+  void add_lane(const ModelInfo* info, const ParamSet& params, bool reported,
+                const std::vector<ParamOverride>& overrides);
   void step_lanes(const FrameInput& in, bool driven);
   void stop_diverged(const FrameInput& in, int f, bool driven);
   void measure(const FrameInput& in);
@@ -346,7 +394,8 @@ std::vector<std::uint32_t> snapshot_strands(const Groom& groom) {
   return out;
 }
 
-void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool reported) {
+void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool reported,
+                           const std::vector<ParamOverride>& overrides) {
   // The probe first: a model whose rest state is unstable must not sleep, or sleeping
   // would freeze the growth it is about to show (and change its metrics).
   verdict::Probe probe;
@@ -369,6 +418,7 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   r.dt = sc_.dt;
   r.settle_from = sc_.settle_from;
   r.params = params_json(params, sc_.groom);
+  if (const auto c = choose_substeps(*info, sc_, params, overrides)) r.substeps = substeps_json(*c);
   r.reference = reference_;
   r.reference_overrides = ref_overrides_;
   if (reported) r.knob = opt_.knob;
@@ -395,14 +445,14 @@ void LockstepRun::make_lanes() {
     if (!info) throw InputError("--models", m, "unknown model");
     reported.emplace_back(info, resolve_params(*info, sc_, concat(opt_.overrides, opt_.model_overrides)));
   }
-  add_lane(ref_info, ref_params, false);
+  add_lane(ref_info, ref_params, false, concat(opt_.overrides, opt_.reference_overrides));
   for (const auto& [info, params] : reported) {
     if (info == ref_info && same_params(params, ref_params)) {
       lanes_[0].reported = true;
       lanes_[0].record.knob = opt_.knob;
       continue;
     }
-    add_lane(info, params, true);
+    add_lane(info, params, true, concat(opt_.overrides, opt_.model_overrides));
   }
 }
 
@@ -457,6 +507,8 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (auto* v : {&r.deviation, &r.jaggedness, &r.length_rms, &r.length_max, &r.rest_shape_error, &r.penetration})
       v->push_back(nan);
+    if (guides_)
+      for (auto* v : {&r.penetration_guides, &r.penetration_follow}) v->push_back(nan);
   }
 }
 
@@ -464,7 +516,7 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
 // one task per lane and metric.
 void LockstepRun::measure(const FrameInput& in) {
   const bool ref_ok = lanes_[0].running;
-  enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFrameMetrics };
+  enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFollowPenetration, kFrameMetrics };
   std::vector<std::array<double, kFrameMetrics>> values(lanes_.size());
   std::vector<metrics::LengthError> length(lanes_.size()), guide_length(lanes_.size());
   pool_.parallel_for(lanes_.size() * kFrameMetrics, [&](std::size_t b, std::size_t e) {
@@ -485,7 +537,14 @@ void LockstepRun::measure(const FrameInput& in) {
               guides_ ? metrics::length_error(*guides_, p.first(sc_.guides.vertex_count())) : length[i];
           break;
         case kRestShape: v[kRestShape] = metrics::rest_shape_error(rest_, p, in.head); break;
-        case kPenetration: v[kPenetration] = metrics::penetration(p, spheres_); break;
+        // With follow hairs, the guides' and the follow hairs' apart; the larger is the
+        // groom's, the same number as one pass over every vertex.
+        case kPenetration:
+          v[kPenetration] = metrics::penetration(guides_ ? p.first(sc_.guides.vertex_count()) : p, spheres_);
+          break;
+        case kFollowPenetration:
+          v[kFollowPenetration] = guides_ ? metrics::penetration(p.subspan(sc_.guides.vertex_count()), spheres_) : 0.0;
+          break;
         case kFrameMetrics: break;
       }
     }
@@ -501,7 +560,11 @@ void LockstepRun::measure(const FrameInput& in) {
     r.length_rms.push_back(length[i].rms);
     r.length_max.push_back(length[i].max);
     r.rest_shape_error.push_back(v[kRestShape]);
-    r.penetration.push_back(v[kPenetration]);
+    r.penetration.push_back(std::max(v[kPenetration], v[kFollowPenetration]));
+    if (guides_) {
+      r.penetration_guides.push_back(v[kPenetration]);
+      r.penetration_follow.push_back(v[kFollowPenetration]);
+    }
     l.stretch.add(in.frame, guide_length[i]);
   }
 }
@@ -533,6 +596,27 @@ void LockstepRun::record_scenario(int frames) const {
   out.dt = sc_.dt;
   out.mean_strand_length = rest_.mean_strand_length;
   out.head_radius = sc_.groom.head_radius;
+  if (sc_.import) {
+    const GroomImport& im = *sc_.import;
+    nlohmann::json repairs = nlohmann::json::array();
+    for (const Repair& r : im.repairs)
+      repairs.push_back({{"kind", r.kind}, {"strands", r.strands}, {"items", r.items}, {"action", r.action},
+                         {"first", r.example}});
+    out.groom = {{"file", im.file.string()},
+                 {"unit", im.unit},
+                 {"unit_from", im.unit_from},
+                 {"pivot", {im.pivot.x(), im.pivot.y(), im.pivot.z()}},
+                 {"pivot_from", im.pivot_from},
+                 {"head_radius_fit", im.head_radius_fit},
+                 {"degenerate", im.degenerate},
+                 {"repairs", std::move(repairs)}};
+    if (im.fitted)
+      out.groom["fit"] = {{"sphere", im.fit.sphere},
+                          {"center_m", {im.fit.center.x(), im.fit.center.y(), im.fit.center.z()}},
+                          {"radius_m", im.fit.radius},
+                          {"rms_residual_m", im.fit.rms_residual},
+                          {"note", im.fit.note}};
+  }
   out.phases.clear();
   for (const Phase& p : scenario_phases(sc_, frames * sc_.dt)) out.phases.push_back({p.start, p.end, p.kind, p.label});
   out.snapshot_strands = snap_strands_;

@@ -36,6 +36,24 @@ void check_param_override(const ParamOverride& o);
 ParamSet resolve_params(const ModelInfo& model, const Scenario& scenario,
                         const std::vector<ParamOverride>& overrides);
 
+// How a run's substeps were chosen (report runs[].substeps). Models with an explicit
+// integrator (ModelInfo::step_bound) take, unless a number is given for them (a scenario's
+// models."*" or models.MODEL, a region, or --set), the larger of their default and the
+// smallest count whose substep is inside the bound for the simulated groom, capped at the
+// parameter's maximum: `substeps: "auto"`, docs/substeps.md.
+struct SubstepsChoice {
+  int value = 0;
+  std::string source;     // "auto", "given" or "default" (auto turned off: Scenario::auto_substeps)
+  int needed = 0;         // auto: the count the bound asks for (more than value when capped)
+  double max_step = 0.0;  // auto: the bound, seconds
+  std::string why;        // auto: the binding term
+  bool capped = false;
+};
+// Empty for a model without a step bound.
+std::optional<SubstepsChoice> choose_substeps(const ModelInfo& model, const Scenario& scenario,
+                                              const ParamSet& resolved, const std::vector<ParamOverride>& overrides);
+nlohmann::json substeps_json(const SubstepsChoice& c);
+
 struct RunOptions {
   std::vector<std::string> models;  // to report, in order
   std::string reference = "";       // empty: the scenario's reference

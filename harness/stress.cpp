@@ -244,6 +244,9 @@ StressWork prepare(const StressOptions& opt) {
   StressWork w;
   w.base = load_scenario(find_scenario(opt.base));
   Scenario& base = w.base;
+  // Each axis escalates a model at its own substeps: picked from the groom, they would
+  // follow the time step and strand axes instead of meeting them.
+  base.auto_substeps = false;
   if (base.follow)
     throw InputError(base.source.string(), "groom.follow_hairs",
                      "stress needs a base whose strands are all simulated (\"simulate\")");

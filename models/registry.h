@@ -2,6 +2,8 @@
 // (docs/architecture.md).
 #pragma once
 
+#include "models/halen2007/step_bounds.h"
+
 #include "core/hair_model.h"
 
 #include <functional>
@@ -32,6 +34,10 @@ struct ModelInfo {
   // For models that need hardware that may be missing (a Vulkan device): why the model
   // cannot run in this context, or "" when it can. Empty function: always available.
   std::function<std::string(const ModelContext&)> unavailable = {};
+  // For models with an explicit integrator: the largest stable substep on a groom with
+  // the resolved parameters and gravity (`substeps: "auto"`, harness/substeps.h). Empty:
+  // the model's step has no such limit (position-based, or a rate in Hz of its own).
+  std::function<halen::StepBound(const Groom&, const ParamSet&, const Vec3f&)> step_bound = {};
 };
 
 std::span<const ModelInfo> model_registry();

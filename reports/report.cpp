@@ -293,6 +293,12 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
       {"rest_shape_error", num(finite_mean(settled))},
       {"penetration", {{"max", num(finite_max(r.penetration))}}},
       {"state_hash", metrics::hash_hex(r.state_hash)}};
+  // Follow hairs are rebuilt from their guides and not collided (as TressFX does not):
+  // their penetration is the follow layer's, apart from the guides' that the model holds.
+  if (!r.penetration_follow.empty()) {
+    metrics["penetration"]["guides_max"] = num(finite_max(r.penetration_guides));
+    metrics["penetration"]["follow_max"] = num(finite_max(r.penetration_follow));
+  }
 
   nlohmann::json failure = nullptr;
   if (r.failure) failure = {{"frame", r.failure->frame}, {"t", r.failure->t}, {"reason", r.failure->reason}};
@@ -331,6 +337,11 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
                          {"penetration", series(r.penetration)}}},
                        {"snapshots", std::move(snapshots)}};
   if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
+  if (!r.substeps.is_null()) out["substeps"] = r.substeps;
+  if (!r.penetration_follow.empty()) {
+    out["series"]["penetration_guides"] = series(r.penetration_guides);
+    out["series"]["penetration_follow"] = series(r.penetration_follow);
+  }
   if (!r.device.empty()) out["device"] = r.device;
   if (!r.gpu_ms.empty()) out["series"]["gpu_ms"] = series(r.gpu_ms);
   if (!r.gpu_ms_lockstep.empty()) out["series"]["gpu_ms_lockstep"] = series(r.gpu_ms_lockstep);
@@ -355,7 +366,7 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
   }
   nlohmann::json ref = nlohmann::json::array();
   for (const auto& snap : sc.reference_snapshots) ref.push_back(snapshot_json(snap));
-  return {{"name", sc.name},
+  nlohmann::json out = {{"name", sc.name},
           {"frames", sc.frames},
           {"dt", sc.dt},
           {"duration", sc.frames * sc.dt},
@@ -371,6 +382,8 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
             {"frames", std::move(frames)},
             {"reference", {{"model", sc.reference}, {"snapshots", std::move(ref)}}}}},
           {"reference_state_hash", metrics::hash_hex(sc.reference_state_hash)}};
+  if (!sc.groom.is_null()) out["groom"] = sc.groom;
+  return out;
 }
 
 nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord>& runs,

@@ -28,6 +28,7 @@ struct RunRecord {
   double dt = 0.0;
   double settle_from = 0.0;
   nlohmann::json params = nlohmann::json::object();
+  nlohmann::json substeps;  // how substeps were chosen (harness/runner.h SubstepsChoice); null: no bound
 
   struct Failure {
     int frame;
@@ -53,6 +54,9 @@ struct RunRecord {
   std::vector<double> length_rms, length_max;
   std::vector<double> rest_shape_error;
   std::vector<double> penetration;
+  // With follow hairs rebuilt from their guides: the guides' and the follow hairs' own
+  // deepest penetration (penetration is the larger); empty otherwise.
+  std::vector<double> penetration_guides, penetration_follow;
   std::vector<double> t;  // time at the end of each frame
   std::map<std::string, double> stage_ms_total;  // summed over the run
   // Steps in which a stage was not needed and not run; absent when never.
@@ -91,6 +95,8 @@ struct ScenarioRecord {
   double dt = 0.0;
   double mean_strand_length = 0.0;  // L-bar, metres: per-vertex deviation is |p - p_ref| / L-bar
   double head_radius = 0.0;
+  // An imported groom: its file, unit, pivot, fitted head and repairs (null otherwise).
+  nlohmann::json groom;
   struct PhaseSpan {
     double start, end;
     std::string kind, label;

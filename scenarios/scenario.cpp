@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -224,6 +225,10 @@ void for_each_element(const Obj& o, std::string_view k, F&& f) {
   for (std::size_t i = 0; i < arr.size(); ++i) f(arr[i], join_index(o.key(k), i));
 }
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
 // ---------------------------------------------------------------------------------------
@@ -317,8 +322,7 @@ std::string position_text(const std::string& text, std::size_t byte) {
   return "line " + std::to_string(line) + ", column " + std::to_string(column);
 }
 
-json parse_file(const Reader& r, const fs::path& file) {
-  const std::string text = read_text(r, file);
+json parse_file(const Reader& r, const std::string& text) {
   KeyPathTracker tracker(r);
   try {
     return json::parse(text, std::ref(tracker));
@@ -379,14 +383,20 @@ void check_increasing(const Reader& r, const std::vector<Key>& keys, const std::
                                              num_text(keys[i - 1].t) + ")");
 }
 
-void read_head(const Obj& top, Scenario& sc) {
+void read_head(const Obj& top, Scenario& sc, bool& head_radius_fit) {
   if (!top.has("head")) return;
   const Reader& r = top.reader();
   const Obj o(r, top.at("head"), top.key("head"), {"radius", "keys", "oscillators"});
-  const double radius = o.number_or("radius", sc.head_radius);
-  // Anything over a metre is surely a unit mistake (centimetres for metres).
-  check_positive(r, o.key("radius"), radius, 1.0);
-  sc.head_radius = static_cast<float>(radius);
+  // "fit": the sphere through an imported groom's roots (read_imported_groom sets it).
+  head_radius_fit = o.has("radius") && o.at("radius").is_string();
+  if (head_radius_fit) {
+    o.one_of("radius", {"fit"});
+  } else {
+    const double radius = o.number_or("radius", sc.head_radius);
+    // Anything over a metre is surely a unit mistake (centimetres for metres).
+    check_positive(r, o.key("radius"), radius, 1.0);
+    sc.head_radius = static_cast<float>(radius);
+  }
   for_each_element(o, "keys", [&](const json& j, const std::string& path) {
     sc.head.keys.push_back(read_head_key(r, j, path));
   });
@@ -409,6 +419,7 @@ struct ImportedGroom {
   std::vector<Sphere> colliders;  // the project's collision spheres, head-attached
   std::optional<tfx::FollowHairs> follow;  // set when follow hairs are rebuilt from guides
   Groom guides;                            // the simulated guides when `follow` is set
+  GroomImport info;
 };
 
 // The guide strands of an asset groom: its first follow.guide_offsets.size() - 1 strands
@@ -430,7 +441,7 @@ void translate(Groom& g, const Vec3f& by) {
 
 // groom: { "tfx": ... } / { "tfx_project": ... }: an imported TressFX asset instead of a
 // generated groom (paths relative to the scenario file).
-ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
+ImportedGroom read_imported_groom(const Obj& g, float head_radius, bool head_radius_fit) {
   const Reader& r = g.reader();
   const bool project = g.has("tfx_project");
   if (project && g.has("tfx")) r.fail(g.key("tfx"), "give either tfx or tfx_project, not both");
@@ -438,39 +449,85 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
   // A bare .tfx file has no follow hairs: their keys would silently do nothing.
   if (!project) g.reject({"follow_hairs", "seed"}, "applies to tfx_project only (a .tfx file has no follow hairs)");
 
-  // TressFX's sample assets are authored in centimetres.
-  const std::string unit = g.one_of_or_first("unit", {"cm", "mm", "m"});
-  const float metres_per_unit = unit == "cm" ? 0.01f : unit == "mm" ? 0.001f : 1.0f;
+  GroomImport info;
+  // TressFX's sample assets are authored in centimetres; "auto" reads the unit from the
+  // groom's size (guess_unit).
+  info.unit = g.one_of_or_first("unit", {"cm", "mm", "m", "auto"});
+  info.degenerate = g.one_of_or_first("degenerate", {"repair", "refuse"});
   const bool simulate_follow = g.one_of_or_first("follow_hairs", {"follow", "simulate"}) == "simulate";
   const std::uint64_t seed = g.has("seed") ? as_seed(r, g.at("seed"), g.key("seed")) : 1;
   // Strands shorter than this (metres) move rigidly with the head (tfx::load_tfx_asset).
   const double rigid_below = g.number_or("rigid_strands_below", 0.0);
   check_range(r, g.key("rigid_strands_below"), rigid_below, 0.0, 1.0);
-  // The pivot is the head centre: the head rest frame's origin, about which it turns.
-  Vec3f pivot = g.has("pivot") ? Vec3f(g.vec3("pivot") * metres_per_unit) : Vec3f::Zero();
+  // The pivot is the head centre: the head rest frame's origin, about which it turns;
+  // "fit": the centre of the sphere through the roots.
+  const bool pivot_fit = g.has("pivot") && g.at("pivot").is_string();
+  if (pivot_fit) g.one_of("pivot", {"fit"});
+  // Only the roots higher than this (file units) are fitted.
+  std::optional<double> fit_above;
+  if (g.has("fit_above")) fit_above = g.number("fit_above");
 
   const fs::path file = (fs::path(r.file()).parent_path() / g.string(key)).lexically_normal();
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) throw InputError(r.file(), g.key(key), "no such file: " + file.string());
+  info.file = file;
 
   tfx::TfxAsset asset;
   try {
-    asset = project ? tfx::load_tfx_project(file, metres_per_unit, seed, rigid_below)
-                    : tfx::load_tfx_asset(file, metres_per_unit, rigid_below);
+    if (info.unit == "auto") {
+      const Groom raw = tfx::read_tfx_strands(file);
+      const auto start = std::chrono::steady_clock::now();
+      const UnitGuess guess = guess_unit(raw, fit_head(raw, fit_above), file.string());
+      info.seconds_fit += seconds_since(start);
+      info.unit = guess.unit;
+      info.unit_from = guess.why;
+    } else {
+      info.unit_from = "given";
+    }
+    const tfx::ImportOptions opt{metres_per_unit(info.unit),
+                                 info.degenerate == "refuse" ? DegeneratePolicy::Refuse : DegeneratePolicy::Repair,
+                                 rigid_below};
+    asset = project ? tfx::load_tfx_project(file, opt, seed) : tfx::load_tfx_asset(file, opt);
   } catch (const InputError& e) {
     // The asset loader names the asset file and the place; say which scenario asked.
     throw InputError(r.file() + ": " + g.key(key) + ": " + e.what());
   }
+  const float mpu = metres_per_unit(info.unit);
+  info.repairs = std::move(asset.repairs);
 
-  // Without one, a project's first collision sphere (TressFX's head sphere) is the centre.
-  if (!g.has("pivot")) {
+  // The sphere through the guides' roots, in metres (follow hairs are offset from them).
+  if (pivot_fit || head_radius_fit) {
+    const auto start = std::chrono::steady_clock::now();
+    info.fit = fit_head(asset.follow.empty() ? asset.groom : guide_groom(asset.groom, asset.follow),
+                        fit_above ? std::optional<double>(*fit_above * mpu) : std::nullopt);
+    info.fitted = true;
+    info.seconds_fit += seconds_since(start);
+  }
+  info.head_radius_fit = head_radius_fit;
+  Vec3f pivot = Vec3f::Zero();
+  if (pivot_fit) {
+    pivot = info.fit.center;
+    info.pivot_from = "fit";
+  } else if (g.has("pivot")) {
+    pivot = g.vec3("pivot") * mpu;
+    info.pivot_from = "given";
+  } else {
+    // Without one, a project's first collision sphere (TressFX's head sphere) is the centre.
     if (asset.colliders.empty())
-      r.fail(g.key("pivot"), std::string("missing required key (the head centre in asset units; ") +
+      r.fail(g.key("pivot"), std::string("missing required key (the head centre in asset units, or \"fit\"; ") +
                                  (project ? "the project has no collision sphere" : "a .tfx file has no head") + ")");
     pivot = asset.colliders.front().center;
+    info.pivot_from = "collision sphere";
   }
+  info.pivot = pivot / mpu;
   translate(asset.groom, -pivot);
   for (Sphere& s : asset.colliders) s.center -= pivot;
+  if (head_radius_fit) {
+    if (!(info.fit.radius > 0.0f && info.fit.radius <= 1.0f))
+      r.fail("head.radius", "the fitted head radius is " + num_text(info.fit.radius) +
+                                " m, outside (0, 1] (check the groom's unit)");
+    head_radius = info.fit.radius;
+  }
   asset.groom.head_radius = head_radius;
 
   ImportedGroom out;
@@ -481,6 +538,7 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius) {
     out.follow = std::move(asset.follow);
   }
   out.groom = std::move(asset.groom);
+  out.info = std::move(info);
   return out;
 }
 
@@ -515,33 +573,50 @@ GroomSpec read_groom_spec(const Reader& r, const json& j, const std::string& pat
 
 // Returns the colliders that come with an imported groom (the caller appends them to
 // the file's own).
-std::vector<Sphere> read_groom(const Obj& top, Scenario& sc) {
+std::vector<Sphere> read_groom(const Obj& top, Scenario& sc, bool head_radius_fit) {
   const Reader& r = top.reader();
   const json& j = top.at("groom");
   const std::string path = top.key("groom");
   if (as_object(r, j, path).contains("tfx") || j.contains("tfx_project")) {
-    ImportedGroom imported = read_imported_groom(
-        Obj(r, j, path, {"tfx", "tfx_project", "unit", "pivot", "follow_hairs", "seed", "rigid_strands_below"}), sc.head_radius);
+    ImportedGroom imported = read_imported_groom(Obj(r, j, path,
+                                                     {"tfx", "tfx_project", "unit", "pivot", "follow_hairs", "seed",
+                                                      "rigid_strands_below", "degenerate", "fit_above"}),
+                                                 sc.head_radius, head_radius_fit);
     sc.groom = std::move(imported.groom);
+    sc.head_radius = sc.groom.head_radius;
     sc.region_params = std::move(imported.region_params);
     sc.follow = std::move(imported.follow);
     sc.guides = std::move(imported.guides);
+    sc.import = std::move(imported.info);
     return std::move(imported.colliders);
   }
+  if (head_radius_fit) r.fail("head.radius", "\"fit\" applies to an imported groom (tfx or tfx_project) only");
   GeneratedGroom generated = generate_groom(read_groom_spec(r, j, path), sc.head_radius, r.file());
   sc.groom = std::move(generated.groom);
   sc.region_params = std::move(generated.region_params);
   return {};
 }
 
-Sphere read_collider(const Reader& r, const json& j, const std::string& path) {
+// "radius": "fit" is the head radius, shrunk until no free rest vertex of the groom lies
+// inside (the sphere the fitted head stands for, without flinging hair out at frame 0).
+Sphere read_collider(const Reader& r, const json& j, const std::string& path, Scenario& sc) {
   const Obj o(r, j, path, {"type", "center", "radius", "attached"});
   o.one_of("type", {"sphere"});
   Sphere s;
   s.center = o.vec3("center");
-  const double radius = o.number("radius");
-  check_positive(r, o.key("radius"), radius);
-  s.radius = static_cast<float>(radius);
+  if (o.has("radius") && o.at("radius").is_string()) {
+    o.one_of("radius", {"fit"});
+    std::vector<Sphere> one{{s.center, sc.head_radius, true}};
+    const auto start = std::chrono::steady_clock::now();
+    tfx::fit_spheres_to_rest_hair(one, sc.groom);
+    if (sc.import) sc.import->seconds_fit += seconds_since(start);
+    if (!(one[0].radius > 0.0f)) r.fail(o.key("radius"), "a free rest vertex lies at the centre: no sphere fits");
+    s.radius = one[0].radius;
+  } else {
+    const double radius = o.number("radius");
+    check_positive(r, o.key("radius"), radius);
+    s.radius = static_cast<float>(radius);
+  }
   s.head_attached = o.one_of_or_first("attached", {"head", "world"}) == "head";
   return s;
 }
@@ -589,6 +664,8 @@ ParamOverrides read_overrides(const Reader& r, const json& j, const std::string&
   for (const auto& [name, value] : as_object(r, j, path).items()) {
     if (name == "regions")
       out.regions = read_region_overrides(r, value, join_key(path, name), groom);
+    else if (name == "substeps" && value.is_string())
+      out.substeps_auto = value == "auto" || (r.fail(join_key(path, name), "expected a number or \"auto\""), false);
     else
       out.base[name] = as_number(r, value, join_key(path, name));
   }
@@ -632,9 +709,9 @@ bool WindScript::ever_active() const {
   return std::any_of(keys.begin(), keys.end(), [](const Key& k) { return k.strength != 0.0; });
 }
 
-Scenario load_scenario(const fs::path& file) {
-  const Reader r(file.string());
-  const json doc = parse_file(r, file);
+namespace {
+
+Scenario load_scenario_doc(const Reader& r, const json& doc, const fs::path& file) {
   const Obj top(r, doc, "",
                 {"name", "description", "frames", "dt", "gravity", "groom", "head", "colliders", "wind",
                  "settle_from", "reference", "models"});
@@ -647,10 +724,11 @@ Scenario load_scenario(const fs::path& file) {
   sc.dt = top.number("dt");
   check_positive(r, top.key("dt"), sc.dt, 1.0);
   sc.gravity = top.vec3_or("gravity", sc.gravity);
-  read_head(top, sc);  // before the groom: the head radius is the scalp radius
-  const std::vector<Sphere> asset_colliders = read_groom(top, sc);
+  bool head_radius_fit = false;
+  read_head(top, sc, head_radius_fit);  // before the groom: the head radius is the scalp radius
+  const std::vector<Sphere> asset_colliders = read_groom(top, sc, head_radius_fit);
   for_each_element(top, "colliders", [&](const json& j, const std::string& path) {
-    sc.colliders.push_back(read_collider(r, j, path));
+    sc.colliders.push_back(read_collider(r, j, path, sc));
   });
   sc.colliders.insert(sc.colliders.end(), asset_colliders.begin(), asset_colliders.end());
   read_wind(top, sc);
@@ -660,6 +738,18 @@ Scenario load_scenario(const fs::path& file) {
   if (sc.reference.empty()) r.fail(top.key("reference"), "must not be empty");
   read_models(top, sc);
   return sc;
+}
+
+}  // namespace
+
+Scenario load_scenario(const fs::path& file) {
+  const Reader r(file.string());
+  return load_scenario_doc(r, parse_file(r, read_text(r, file)), file);
+}
+
+Scenario load_scenario_text(const std::string& text, const fs::path& file) {
+  const Reader r(file.string());
+  return load_scenario_doc(r, parse_file(r, text), file);
 }
 
 fs::path builtin_scenario_dir() {

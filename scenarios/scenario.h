@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/groom.h"
+#include "core/groom_fit.h"
 #include "scenarios/groom_gen.h"
 #include "scenarios/head_motion.h"
 #include "scenarios/tfx/tfx.h"
@@ -33,6 +34,23 @@ struct WindScript {
 struct ParamOverrides {
   std::map<std::string, double> base;
   std::map<std::string, std::map<std::string, double>> regions;  // region name -> values
+  bool substeps_auto = false;  // "substeps": "auto" (harness/substeps.h)
+};
+
+// How an imported groom was placed and cleaned, for the terminal and the report's
+// scenarios[].groom (docs/report-schema.md).
+struct GroomImport {
+  std::filesystem::path file;
+  std::string unit;
+  std::string unit_from;   // "given", or how it was guessed (guess_unit)
+  Vec3f pivot = Vec3f::Zero();  // file units
+  std::string pivot_from;  // "given", "collision sphere" or "fit"
+  HeadFit fit;             // the sphere through the guides' roots, metres; set when anything was fitted
+  bool fitted = false;
+  bool head_radius_fit = false;
+  std::string degenerate = "repair";
+  std::vector<Repair> repairs;
+  double seconds_fit = 0.0;  // guessing the unit, fitting the head sphere and the collider
 };
 
 struct Scenario {
@@ -59,6 +77,10 @@ struct Scenario {
   double settle_from = 0.0;
   std::string reference = "han_m1";
   std::map<std::string, ParamOverrides> models;  // "*" and model names, as in the file
+  std::optional<GroomImport> import;              // set for an imported TressFX groom
+  // Explicit models pick their substeps from the groom when nobody gives a number
+  // (harness/substeps.h); stress runs turn that off to escalate a model as it is.
+  bool auto_substeps = true;
 
   double duration() const { return frames * dt; }
 };
@@ -67,6 +89,9 @@ struct Scenario {
 // "FILE: KEY: what is wrong" (unknown keys, wrong types, missing or non-finite numbers,
 // out-of-range values, missing referenced files).
 Scenario load_scenario(const std::filesystem::path& file);
+// The same for a scenario held as JSON text; `file` names it in messages, and paths in
+// it are relative to file's folder.
+Scenario load_scenario_text(const std::string& text, const std::filesystem::path& file);
 
 // The folder of built-in scenarios (scenarios/builtin in the source tree, or
 // $HAIRBENCH_SCENARIO_DIR), and its scenario files sorted by name.

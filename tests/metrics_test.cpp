@@ -285,7 +285,7 @@ TEST(Jaggedness, TressFxAssetsRigidAboutZeroPerturbedAbove) {
   const std::filesystem::path assets = HAIRBENCH_ASSET_DIR;
   for (const char* file : {"testhair1/TestHair1.tfx", "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx", "ponytail/front_top.tfx",
                            "ponytail/side.tfx", "ponytail/back.tfx", "ponytail/tail.tfx"}) {
-    const Groom g = tfx::load_tfx_asset(assets / file, 0.01f).groom;
+    const Groom g = tfx::load_tfx_asset(assets / file, {0.01f}).groom;
     const metrics::RestInfo rest(g);
     EXPECT_EQ(metrics::jaggedness(rest, g.positions), 0.0) << file;
     const std::vector<Vec4f> moved = transformed(g.positions, some_rigid_motion());

@@ -309,7 +309,7 @@ TEST(ShippedAssets, TestHair1Project) {
 TEST(ShippedAssets, PonytailProjectLoadsInMetres) {
   const fs::path file = kAssets / "ponytail/ponytail.tfxproj";
   ASSERT_PRESENT(file);
-  const TfxAsset a = load_tfx_project(file, 0.01f, 7);
+  const TfxAsset a = load_tfx_project(file, {0.01f}, 7);
   const std::size_t guides = 876 + 3066 + 517 + 474;
   EXPECT_EQ(a.groom.region_names,
             (std::vector<std::string>{"front-and-top", "side", "back", "tail"}));
@@ -354,7 +354,7 @@ TEST(ShippedAssets, PonytailProjectLoadsInMetres) {
 TEST(ShippedAssets, TestHair1ProjectLoads) {
   const fs::path file = kAssets / "testhair1/TestHair1.tfxproj";
   ASSERT_PRESENT(file);
-  const TfxAsset a = load_tfx_project(file, 0.01f, 3);
+  const TfxAsset a = load_tfx_project(file, {0.01f}, 3);
   EXPECT_EQ(a.groom.region_names, std::vector<std::string>{"TestHair"});
   EXPECT_EQ(a.groom.strand_count(), 10027u * 5u);
   EXPECT_EQ(a.follow.strand_count(), 10027u * 4u);
@@ -366,20 +366,23 @@ TEST(ShippedAssets, TestHair1ProjectLoads) {
 }
 
 // The mohawk has stubble: 18 strands under 0.4 mm with 32 vertices each. With
-// rigid_below, exactly the strands shorter than it are pinned whole; the others keep the
-// file's pins (vertices 0 and 1).
+// rigid_below, exactly the strands shorter than it are pinned whole, besides those the
+// import's repairs pin (under 1/10 of the median strand); the others keep the file's pins
+// (vertices 0 and 1).
 TEST(ShippedAssets, RigidBelowPinsOnlyTheShortStrands) {
   const fs::path file = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
   ASSERT_PRESENT(file);
-  const TfxAsset plain = load_tfx_asset(file, 0.01f);
-  const TfxAsset rigid = load_tfx_asset(file, 0.01f, 0.005);
+  const TfxAsset plain = load_tfx_asset(file, {0.01f});
+  const TfxAsset rigid = load_tfx_asset(file, {0.01f, DegeneratePolicy::Repair, 0.005});
   std::size_t pinned_whole = 0, short_strands = 0;
   for (std::size_t s = 0; s < plain.groom.strand_count(); ++s) {
     const std::uint32_t b = plain.groom.strand_begin(s), n = plain.groom.strand_size(s);
     double length = 0.0;
     for (std::uint32_t i = b + 1; i < b + n; ++i)
       length += (plain.groom.positions[i] - plain.groom.positions[i - 1]).head<3>().cast<double>().norm();
-    const bool is_short = length < 0.005;
+    bool repaired = true;
+    for (std::uint32_t i = b; i < b + n; ++i) repaired &= plain.groom.positions[i].w() == 0.0f;
+    const bool is_short = length < 0.005 || repaired;
     short_strands += is_short;
     bool all_pinned = true;
     for (std::uint32_t i = b; i < b + n; ++i) {
@@ -400,7 +403,7 @@ TEST(ShippedAssets, RigidBelowPinsOnlyTheShortStrands) {
 TEST(ShippedAssets, SingleTfxAsset) {
   const fs::path file = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
   ASSERT_PRESENT(file);
-  const TfxAsset a = load_tfx_asset(file, 0.01f);
+  const TfxAsset a = load_tfx_asset(file, {0.01f});
   EXPECT_EQ(a.groom.region_names, std::vector<std::string>{"Ratboy_mohawk"});
   EXPECT_EQ(a.groom.strand_count(), 2226u);
   EXPECT_EQ(a.groom.vertex_count(), 2226u * 32u);
@@ -432,7 +435,7 @@ TEST(MiniProject, ReadsV3AndV4) {
 TEST(MiniProject, LoadsRegionsParamsCollidersAndFollowHairs) {
   const fs::path file = kData / "mini/mini.tfxproj";
   ASSERT_PRESENT(file);
-  const TfxAsset a = load_tfx_project(file, 0.01f, 1);
+  const TfxAsset a = load_tfx_project(file, {0.01f}, 1);
   EXPECT_EQ(a.groom.region_names, (std::vector<std::string>{"crown", "b"}));
   // Project iterations (4, 3) as defaults, each .tfxsim overriding what it sets.
   const std::map<std::string, double> crown{{"damping", 0.2},          {"local_stiffness", 0.7},
@@ -454,8 +457,8 @@ TEST(MiniProject, LoadsRegionsParamsCollidersAndFollowHairs) {
   EXPECT_EQ(a.colliders[1].center, Vec3f(1.5f, -2.0f, 3.0f) * 0.01f);
   EXPECT_EQ(a.colliders[1].radius, 4.5f * 0.01f);
   // Same seed, same groom; another seed moves the follow hairs.
-  EXPECT_EQ(load_tfx_project(file, 0.01f, 1).groom.positions, a.groom.positions);
-  EXPECT_NE(load_tfx_project(file, 0.01f, 2).groom.positions, a.groom.positions);
+  EXPECT_EQ(load_tfx_project(file, {0.01f}, 1).groom.positions, a.groom.positions);
+  EXPECT_NE(load_tfx_project(file, {0.01f}, 2).groom.positions, a.groom.positions);
 }
 
 TEST(Loaders, ReportMissingFilesAndBadScale) {
@@ -464,9 +467,9 @@ TEST(Loaders, ReportMissingFilesAndBadScale) {
   EXPECT_NE(input_error([] { read_tfxsim(kData / "no_such.tfxsim"); }).find("no_such.tfxsim"),
             std::string::npos);
   ASSERT_PRESENT(kData / "mini/a.tfx");
-  EXPECT_NE(input_error([] { load_tfx_asset(kData / "mini/a.tfx", 0.0f); }).find("metres_per_unit"),
+  EXPECT_NE(input_error([] { load_tfx_asset(kData / "mini/a.tfx", {0.0f}); }).find("metres_per_unit"),
             std::string::npos);
-  EXPECT_NE(input_error([] { load_tfx_asset(kData / "mini/a.tfx", NAN); }).find("metres_per_unit"),
+  EXPECT_NE(input_error([] { load_tfx_asset(kData / "mini/a.tfx", {NAN}); }).find("metres_per_unit"),
             std::string::npos);
 }
 
@@ -764,10 +767,6 @@ std::vector<BadTfx> bad_tfx_cases() {
   c.push_back({"NaN inverse mass", b, "byte 268: inverse mass is NaN or infinite"});
   put_f32(b, v4_at + 12, -1.0f);
   c.push_back({"negative inverse mass", b, "byte 268: negative inverse mass -1"});
-  b = v3();
-  for (std::size_t k = 0; k < 12; ++k) b[v3_at + k] = b[v3_at - 12 + k];
-  c.push_back({"zero-length edge", b,
-               "byte 368: strand 1 vertex 2: zero-length edge (same position as vertex 1)"});
   return c;
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "core/groom.h"
+#include "core/groom_fit.h"
 #include "core/types.h"
 
 #include <cstddef>
@@ -156,13 +157,25 @@ struct TfxAsset {
   std::vector<std::map<std::string, double>> region_params;  // one per groom region
   std::vector<Sphere> colliders;                             // metres, head-attached, fitted to the rest hair
   FollowHairs follow;                                        // empty when there are no follow hairs
+  std::vector<Repair> repairs;                               // what repair_groom did to the guides
 };
 
+// How an asset is read: its scale, what to do with degenerate strands (repair_groom,
+// before any follow hair is made), and the strands to pin whole (pin_short_strands in
+// tfx_asset.cpp).
+struct ImportOptions {
+  float metres_per_unit = 0.01f;
+  DegeneratePolicy degenerate = DegeneratePolicy::Repair;
+  double rigid_below = 0.0;
+};
+
+// The guide strands of an asset file or project in file units, as read (no repair, no
+// scale): what a unit is guessed from (guess_unit). A project's strands are its
+// sections' in order.
+Groom read_tfx_strands(const std::filesystem::path& file);
+
 // One .tfx file: one region named after the file stem, no parameters, no colliders.
-// Strands shorter than `rigid_below` metres get every vertex pinned (0: none; see
-// pin_short_strands in tfx_asset.cpp for why).
-TfxAsset load_tfx_asset(const std::filesystem::path& file, float metres_per_unit,
-                        double rigid_below = 0.0);
+TfxAsset load_tfx_asset(const std::filesystem::path& file, const ImportOptions& opt);
 
 // A .tfxproj with its .tfx and .tfxsim files (paths relative to the project): one region
 // per section, named by the section, with the project's parameters overridden by the
@@ -171,7 +184,9 @@ TfxAsset load_tfx_asset(const std::filesystem::path& file, float metres_per_unit
 // its centre and shrinks, where needed, until no free rest vertex (follow hairs included)
 // lies inside it: TressFX's spheres overlap the hair they stand for the head under.
 // Guides shorter than `rigid_below` metres, and their follow hairs, are pinned whole.
-TfxAsset load_tfx_project(const std::filesystem::path& file, float metres_per_unit,
-                          std::uint64_t seed, double rigid_below = 0.0);
+TfxAsset load_tfx_project(const std::filesystem::path& file, const ImportOptions& opt, std::uint64_t seed);
+
+// Shrinks each sphere, keeping its centre, until no free vertex of `g` lies inside it.
+void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g);
 
 }  // namespace hairbench::tfx

@@ -69,10 +69,9 @@ void pin_short_strands(Groom& g, double min_length) {
 // each sphere keeps its centre and shrinks to the largest radius that no free rest vertex
 // lies inside (pinned vertices are never collided). Then no vertex is inside a collider at
 // rest, and the penetration metric measures what the motion adds.
-void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g) {
-  for (Sphere& s : spheres)
-    for (const Vec4f& p : g.positions)
-      if (p.w() != 0.0f) s.radius = std::min(s.radius, (p.head<3>() - s.center).norm());
+// The path of a project's section file, for the strands' reader.
+std::filesystem::path section_path(const std::filesystem::path& project, const std::string& file) {
+  return project.parent_path() / file;
 }
 
 Sphere to_metres(const Sphere& s, float metres_per_unit, const std::string& source) {
@@ -86,24 +85,40 @@ Sphere to_metres(const Sphere& s, float metres_per_unit, const std::string& sour
 
 }  // namespace
 
-TfxAsset load_tfx_asset(const std::filesystem::path& file, float metres_per_unit,
-                        double rigid_below) {
-  check_scale(file, metres_per_unit);
+void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g) {
+  for (Sphere& s : spheres)
+    for (const Vec4f& p : g.positions)
+      if (p.w() != 0.0f) s.radius = std::min(s.radius, (p.head<3>() - s.center).norm());
+}
+
+Groom read_tfx_strands(const std::filesystem::path& file) {
+  Groom g;
+  if (file.extension() != ".tfxproj") {
+    append_strands(g, read_tfx(file), 1.0f, 0, file.string());
+    return g;
+  }
+  for (const TfxProject::Section& section : read_tfxproj(file).sections)
+    append_strands(g, read_tfx(section_path(file, section.tfx_file)), 1.0f, 0, file.string());
+  return g;
+}
+
+TfxAsset load_tfx_asset(const std::filesystem::path& file, const ImportOptions& opt) {
+  check_scale(file, opt.metres_per_unit);
   const TfxStrands strands = read_tfx(file);
   TfxAsset asset;
   asset.groom.region_names = {file.stem().string()};
-  append_strands(asset.groom, strands, metres_per_unit, 0, file.string());
+  append_strands(asset.groom, strands, opt.metres_per_unit, 0, file.string());
   asset.region_params.resize(1);
+  asset.repairs = repair_groom(asset.groom, opt.degenerate, file.string());
   validate_groom(asset.groom, file.string());
-  pin_short_strands(asset.groom, rigid_below);
+  pin_short_strands(asset.groom, opt.rigid_below);
   return asset;
 }
 
-TfxAsset load_tfx_project(const std::filesystem::path& file, float metres_per_unit,
-                          std::uint64_t seed, double rigid_below) {
-  check_scale(file, metres_per_unit);
+TfxAsset load_tfx_project(const std::filesystem::path& file, const ImportOptions& opt, std::uint64_t seed) {
+  check_scale(file, opt.metres_per_unit);
+  const float metres_per_unit = opt.metres_per_unit;
   const TfxProject project = read_tfxproj(file);
-  const std::filesystem::path dir = file.parent_path();
   const std::string source = file.string();
   if (project.sections.size() > std::numeric_limits<std::uint16_t>::max() + std::size_t{1})
     throw InputError(source, "sections", "more sections than 16-bit region indices hold");
@@ -111,23 +126,26 @@ TfxAsset load_tfx_project(const std::filesystem::path& file, float metres_per_un
   TfxAsset asset;
   Groom guides;
   guides.region_names.clear();
-  std::vector<std::size_t> first_strand;
   for (std::size_t i = 0; i < project.sections.size(); ++i) {
     const TfxProject::Section& section = project.sections[i];
-    const TfxStrands strands = read_tfx(dir / section.tfx_file);
+    const TfxStrands strands = read_tfx(section_path(file, section.tfx_file));
     // A section's .tfxsim overrides the project-level values (TressFX reads the project
     // iteration counts as defaults).
     std::map<std::string, double> params = project.params;
-    for (const auto& [key, value] : read_tfxsim(dir / section.sim_file).params) params[key] = value;
-    first_strand.push_back(guides.strand_count());
+    for (const auto& [key, value] : read_tfxsim(section_path(file, section.sim_file)).params) params[key] = value;
     append_strands(guides, strands, metres_per_unit, static_cast<std::uint16_t>(i), source);
     guides.region_names.push_back(section.name);
     asset.region_params.push_back(std::move(params));
   }
-  first_strand.push_back(guides.strand_count());
+  // Repairs may remove strands: the sections' first strands are counted after them.
+  asset.repairs = repair_groom(guides, opt.degenerate, source);
+  std::vector<std::size_t> first_strand(project.sections.size() + 1, guides.strand_count());
+  for (std::size_t s = guides.strand_count(); s-- > 0;) first_strand[guides.strand_region[s]] = s;
+  for (std::size_t i = project.sections.size(); i-- > 0;)
+    first_strand[i] = std::min(first_strand[i], first_strand[i + 1]);
   validate_groom(guides, source);
   // Before the follow hairs, which take their guide's inverse masses.
-  pin_short_strands(guides, rigid_below);
+  pin_short_strands(guides, opt.rigid_below);
 
   FollowHairs follow;
   follow.guide_offsets = guides.strand_offsets;

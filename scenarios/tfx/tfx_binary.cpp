@@ -143,12 +143,9 @@ void read_positions(const Bytes& in, std::size_t offset, std::size_t stride, Tfx
       const std::size_t at = offset + k * stride;
       const Vec3f p(in.f32(at), in.f32(at + 4), in.f32(at + 8));
       if (!p.allFinite()) in.fail(at, vertex_name(s, i) + ": position is NaN or infinite");
+      // Coincident vertices (a zero-length edge) are read as they are: the asset loaders
+      // repair or refuse them with the groom's other defects (repair_groom).
       out.positions[k] = Vec4f(p.x(), p.y(), p.z(), inverse_mass(at, i));
-      // Exactly coincident vertices give no edge direction, which every model's frames
-      // need; the loaders re-check edges in metres with validate_groom's tolerance.
-      if (i > 0 && (out.positions[k] - out.positions[k - 1]).head<3>().squaredNorm() == 0.0f)
-        in.fail(at, vertex_name(s, i) + ": zero-length edge (same position as vertex " +
-                        std::to_string(i - 1) + ")");
     }
   }
 }

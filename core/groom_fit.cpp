@@ -1,0 +1,321 @@
+#include "core/groom_fit.h"
+
+#include "core/error.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+namespace hairbench {
+namespace {
+
+using Vec3d = Eigen::Vector3d;
+
+Vec3d root_of(const Groom& g, std::size_t s) { return g.positions[g.strand_begin(s)].head<3>().cast<double>(); }
+
+std::string text(double v, int digits = 3) {
+  std::ostringstream os;
+  os << std::setprecision(digits) << v;
+  return os.str();
+}
+
+struct Sphere3 {
+  Vec3d c = Vec3d::Zero();
+  double r = 0.0;
+  bool ok = false;
+};
+
+// The algebraic least-squares sphere through `pts` (relative to `origin`).
+Sphere3 lsq_sphere(const std::vector<Vec3d>& pts, const std::vector<char>& use, const Vec3d& origin) {
+  Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d b = Eigen::Vector4d::Zero();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!use[i]) continue;
+    const Vec3d q = pts[i] - origin;
+    const Eigen::Vector4d row(2.0 * q.x(), 2.0 * q.y(), 2.0 * q.z(), 1.0);
+    a += row * row.transpose();
+    b += row * q.squaredNorm();
+    ++n;
+  }
+  Sphere3 s;
+  if (n < 4) return s;
+  const Eigen::ColPivHouseholderQR<Eigen::Matrix4d> qr(a);
+  // Roots on a plane or a line leave the centre free along a direction: no sphere.
+  if (qr.rank() < 4) return s;
+  const Eigen::Vector4d x = qr.solve(b);
+  const double r2 = x[3] + x.head<3>().squaredNorm();
+  if (!(r2 > 0.0) || !x.allFinite()) return s;
+  s.c = origin + x.head<3>();
+  s.r = std::sqrt(r2);
+  s.ok = true;
+  return s;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Strand s's edge lengths in double: e[i] is edge (i, i+1).
+void edge_lengths(const Groom& g, std::size_t s, std::vector<double>& e) {
+  const std::uint32_t b = g.strand_begin(s), n = g.strand_size(s);
+  e.resize(n - 1);
+  for (std::uint32_t i = 1; i < n; ++i)
+    e[i - 1] = (g.positions[b + i] - g.positions[b + i - 1]).head<3>().cast<double>().norm();
+}
+
+// The strand resampled to its vertex count at equal arc-length steps along its polyline.
+void resample(Groom& g, std::size_t s, const std::vector<double>& e) {
+  const std::uint32_t b = g.strand_begin(s), n = g.strand_size(s);
+  std::vector<Vec3d> old(n);
+  for (std::uint32_t i = 0; i < n; ++i) old[i] = g.positions[b + i].head<3>().cast<double>();
+  double total = 0.0;
+  for (double l : e) total += l;
+  std::uint32_t seg = 0;  // the segment (seg, seg + 1) the target lies on
+  double seg_start = 0.0;  // arc length at old[seg]
+  for (std::uint32_t k = 1; k + 1 < n; ++k) {
+    const double target = total * k / (n - 1);
+    while (seg + 1 < n - 1 && seg_start + e[seg] < target) seg_start += e[seg++];
+    const double f = e[seg] > 0.0 ? std::clamp((target - seg_start) / e[seg], 0.0, 1.0) : 0.0;
+    const Vec3d p = old[seg] + f * (old[seg + 1] - old[seg]);
+    g.positions[b + k].head<3>() = p.cast<float>();
+  }
+  // The ends stay where they were.
+}
+
+std::string edge_example(std::size_t s, std::size_t edge, double length) {
+  return "strand " + std::to_string(s) + " edge " + std::to_string(edge) + " (" + text(length) + " m)";
+}
+
+}  // namespace
+
+HeadFit fit_head(const Groom& g, std::optional<double> above) {
+  HeadFit fit;
+  const std::size_t n = g.strand_count();
+  std::vector<Vec3d> roots(n);
+  std::vector<char> use(n, 0);
+  Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::max()), hi = -lo, mean = Vec3d::Zero();
+  std::size_t used = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    roots[s] = root_of(g, s);
+    if (above && !(roots[s].y() > *above)) continue;
+    use[s] = 1;
+    ++used;
+    lo = lo.cwiseMin(roots[s]);
+    hi = hi.cwiseMax(roots[s]);
+    mean += roots[s];
+  }
+  if (used == 0) {
+    fit.note = "no root lies above the fit height";
+    fit.radius = static_cast<float>(std::max(mean_strand_length(g) / 2.0, 1e-6));
+    return fit;
+  }
+  mean /= static_cast<double>(used);
+  double spread = 0.0;
+  for (std::size_t s = 0; s < n; ++s)
+    if (use[s]) spread += (roots[s] - mean).squaredNorm();
+  spread = std::sqrt(spread / static_cast<double>(used));
+
+  const Sphere3 s = lsq_sphere(roots, use, mean);
+  if (s.ok) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (use[i]) {
+        const double d = (roots[i] - s.c).norm() - s.r;
+        sum += d * d;
+      }
+    fit.rms_residual = std::sqrt(sum / static_cast<double>(used));
+    if (fit.rms_residual > kSphereResidual * s.r)
+      fit.note = "the roots are " + text(fit.rms_residual / s.r) + " of its radius off the best sphere";
+    else if (s.r > kSphereSpread * spread)
+      fit.note = "the roots are nearly flat (the best sphere is " + text(s.r / spread) + " times their spread)";
+    else fit.sphere = true;
+  } else {
+    fit.note = used < 4 ? "fewer than 4 roots" : "the roots lie on a plane or a line";
+  }
+  if (fit.sphere) {
+    fit.center = s.c.cast<float>();
+    fit.radius = static_cast<float>(s.r);
+    return fit;
+  }
+  // No head: the middle of the roots, and a sphere that fits inside their box.
+  const Vec3d extent = hi - lo;
+  fit.center = ((lo + hi) / 2.0).cast<float>();
+  double radius = std::max(extent.minCoeff() / 2.0, extent.norm() / 8.0);
+  if (!(radius > 0.0)) radius = mean_strand_length(g) / 2.0;
+  fit.radius = static_cast<float>(radius);
+  fit.note += "; pivot at the roots' bounding-box centre, radius " + text(radius);
+  return fit;
+}
+
+float metres_per_unit(const std::string& unit) { return unit == "cm" ? 0.01f : unit == "mm" ? 0.001f : 1.0f; }
+
+UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source) {
+  double size = fit.radius;
+  double lo = kHeadRadiusMin, hi = kHeadRadiusMax;
+  std::string what = "head radius";
+  if (!fit.sphere) {
+    Vec3d a = Vec3d::Constant(std::numeric_limits<double>::max()), b = -a;
+    for (std::size_t s = 0; s < g.strand_count(); ++s) {
+      a = a.cwiseMin(root_of(g, s));
+      b = b.cwiseMax(root_of(g, s));
+    }
+    size = (b - a).norm();
+    lo = kRootSpanMin;
+    hi = kRootSpanMax;
+    what = "roots' bounding-box diagonal";
+  }
+  std::vector<std::string> fits;
+  for (const char* unit : {"m", "cm", "mm"}) {
+    const double m = size * metres_per_unit(unit);
+    if (m >= lo && m < hi) fits.emplace_back(unit);  // half-open: ranges under 10x never match two units
+  }
+  const std::string range = "[" + text(lo) + ", " + text(hi) + "] m";
+  if (fits.size() != 1)
+    throw InputError(source, "unit",
+                     "cannot tell the unit: the " + what + " is " + text(size, 4) + " file units, which is " +
+                         (fits.empty() ? "outside " + range + " in m, cm and mm"
+                                       : "within " + range + " in both " + fits[0] + " and " + fits[1]) +
+                         "; give it (--unit, or \"unit\" in the scenario file)");
+  UnitGuess out;
+  out.unit = fits[0];
+  out.metres_per_unit = metres_per_unit(out.unit);
+  out.why = what + " " + text(size, 4) + " file units = " + text(size * out.metres_per_unit) + " m";
+  return out;
+}
+
+std::vector<Repair> repair_groom(Groom& g, DegeneratePolicy policy, const std::string& source) {
+  std::vector<Repair> out;
+  const auto fail = [&](const std::string& field, const std::string& what) { throw InputError(source, field, what); };
+
+  // Near-zero edges: relative to the strand's own median edge, and never under 1e-7 m,
+  // validate_groom's floor.
+  Repair edges{"near_zero_edges", 0, 0, "strand resampled at equal arc-length steps", ""};
+  std::vector<double> e, sorted;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    if (g.strand_size(s) < 2) continue;  // validate_groom names it
+    edge_lengths(g, s, e);
+    sorted = e;
+    const double limit = std::max(kNearZeroEdge * median(sorted), 1e-7);
+    std::size_t bad = 0;
+    double total = 0.0;
+    for (std::size_t i = 0; i < e.size(); ++i) {
+      total += e[i];
+      if (e[i] >= limit) continue;
+      if (policy == DegeneratePolicy::Refuse)
+        fail("strand " + std::to_string(s) + " edge " + std::to_string(i),
+             "near-zero rest edge of " + text(e[i]) + " m (under " + text(kNearZeroEdge) +
+                 " of the strand's median edge; \"degenerate\": \"repair\" resamples the strand)");
+      if (edges.example.empty()) edges.example = edge_example(s, i, e[i]);
+      ++bad;
+    }
+    if (bad == 0) continue;
+    // Resampling spreads the length over the edges; a strand with (almost) none cannot be.
+    if (!(total > 1e-7 * static_cast<double>(e.size())))
+      fail("strand " + std::to_string(s), "has zero length (every vertex at one point)");
+    resample(g, s, e);
+    edges.items += bad;
+    ++edges.strands;
+  }
+  if (edges.strands > 0) out.push_back(edges);
+
+  // Duplicate strands: the same vertices as an earlier strand (exporters that write a
+  // strand twice). Grouped by the root's bits, then compared whole.
+  Repair dups{"coincident_roots", 0, 0, "duplicate strand removed", ""};
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> by_root;
+  std::vector<char> keep(g.strand_count(), 1);
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    const Vec4f& r = g.positions[g.strand_begin(s)];
+    std::array<std::uint32_t, 3> bits{};
+    std::memcpy(bits.data(), r.data(), sizeof bits);
+    const std::uint64_t key = (std::uint64_t{bits[0]} * 0x9e3779b97f4a7c15ull) ^
+                              (std::uint64_t{bits[1]} * 0xc2b2ae3d27d4eb4full) ^ bits[2];
+    auto& same = by_root[key];
+    for (std::size_t t : same) {
+      if (g.strand_size(t) != g.strand_size(s)) continue;
+      bool equal = true;
+      for (std::uint32_t i = 0; i < g.strand_size(s) && equal; ++i)
+        equal = (g.positions[g.strand_begin(s) + i] - g.positions[g.strand_begin(t) + i]).head<3>().norm() <= 1e-7f;
+      if (!equal) continue;
+      if (policy == DegeneratePolicy::Refuse)
+        fail("strand " + std::to_string(s),
+             "repeats strand " + std::to_string(t) + " vertex for vertex (coincident roots; \"degenerate\": "
+             "\"repair\" removes the copy)");
+      if (dups.example.empty()) dups.example = "strand " + std::to_string(s) + " repeats strand " + std::to_string(t);
+      keep[s] = 0;
+      ++dups.strands;
+      break;
+    }
+    if (keep[s]) same.push_back(s);
+  }
+  if (dups.strands > 0) {
+    dups.items = dups.strands;
+    Groom kept;
+    kept.region_names = g.region_names;
+    kept.head_radius = g.head_radius;
+    for (std::size_t s = 0; s < g.strand_count(); ++s) {
+      if (!keep[s]) continue;
+      const auto b = g.positions.begin() + g.strand_begin(s);
+      kept.positions.insert(kept.positions.end(), b, b + g.strand_size(s));
+      kept.strand_offsets.push_back(static_cast<std::uint32_t>(kept.positions.size()));
+      kept.strand_region.push_back(g.strand_region[s]);
+    }
+    g = std::move(kept);
+    out.push_back(dups);
+  }
+
+  // Strands far shorter than the rest move rigidly with the head.
+  std::vector<double> lengths(g.strand_count());
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    edge_lengths(g, s, e);
+    for (double l : e) lengths[s] += l;
+  }
+  const double short_limit = kShortStrand * median(lengths);
+  Repair shorts{"short_strands", 0, 0, "every vertex pinned (moves rigidly with the head)", ""};
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    if (lengths[s] >= short_limit) continue;
+    const std::uint32_t b = g.strand_begin(s), n = g.strand_size(s);
+    bool free = false;
+    for (std::uint32_t i = b; i < b + n; ++i) free = free || g.positions[i].w() != 0.0f;
+    if (!free) continue;  // already rigid
+    if (policy == DegeneratePolicy::Refuse)
+      fail("strand " + std::to_string(s), "is " + text(lengths[s]) + " m long, under " + text(kShortStrand) +
+                                              " of the median strand (" + text(median(lengths)) +
+                                              " m; \"degenerate\": \"repair\" pins it)");
+    if (shorts.example.empty()) shorts.example = "strand " + std::to_string(s) + " (" + text(lengths[s]) + " m)";
+    for (std::uint32_t i = b; i < b + n; ++i) g.positions[i].w() = 0.0f;
+    ++shorts.strands;
+  }
+  shorts.items = shorts.strands;
+  if (shorts.strands > 0) out.push_back(shorts);
+  return out;
+}
+
+std::string repairs_text(const std::vector<Repair>& repairs) {
+  if (repairs.empty()) return "repairs: none";
+  std::string out = "repairs:";
+  for (std::size_t i = 0; i < repairs.size(); ++i) {
+    const Repair& r = repairs[i];
+    out += i == 0 ? " " : "; ";
+    if (r.kind == "near_zero_edges")
+      out += std::to_string(r.items) + " near-zero edges in " + std::to_string(r.strands) + " strands resampled";
+    else if (r.kind == "coincident_roots")
+      out += std::to_string(r.strands) + " duplicate strands removed";
+    else
+      out += std::to_string(r.strands) + " short strands pinned";
+    out += " (first: " + r.example + ")";
+  }
+  return out;
+}
+
+}  // namespace hairbench

@@ -1,0 +1,47 @@
+// The largest substep each Halén & Wester model's explicit integrator takes stably on a
+// given groom, from the model's equations (docs/substeps.md). `substeps: "auto"` divides
+// the frame by it (harness/substeps.h).
+#pragma once
+
+#include "core/groom.h"
+#include "core/params.h"
+#include "core/types.h"
+
+#include <string>
+
+namespace hairbench::halen {
+
+struct StepBound {
+  double max_step = 0.0;  // seconds; 0 when no step is stable (the caller caps the count)
+  std::string why;        // the binding term with its numbers, for the report
+};
+
+// Verlet (Eq. 4.1) of a vertex held by a zero-rest-length spring of strength k per unit
+// mass is x'' = -k x, stable for omega h < 2 with omega = sqrt(k); we keep omega h <= 1.
+inline constexpr double kOmegaStep = 1.0;
+// The edge correction (Eq. 4.2) moves both ends of an edge along its current direction. A
+// substep that carries a free vertex further than a fraction of its shortest edge, under
+// gravity and the spring that holds gravity up (2 |g| h^2), can turn that edge over before
+// the correction sees it, and the chain folds: the mohawk's 0.6 mm edges at 6 substeps.
+inline constexpr double kEdgeTravel = 0.05;
+
+// halen_spring: min(kOmegaStep / sqrt(k_max), sqrt(kEdgeTravel l_min / (2 |g|))), k_max
+// the strongest spring (§5.9's falloff holds it at `stiffness` near the root) and l_min
+// the shortest rest edge with a free end.
+StepBound spring_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity);
+
+// halen_cascade: the spring bound with k_max = (k_up + k_down)(1 + r)^2, r the largest
+// ratio of an edge to the edge before it: a reference node d from its space's origin
+// pushes back on the segment that carries the space through a lever l (f_A ~ |R| d / l,
+// kernels::cascade_accelerations), which multiplies the spring's stiffness on that
+// segment by up to (1 + d / l)^2.
+StepBound cascade_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity);
+
+// halen_forest: explicit Euler of the joint angles (Eq. 4.2.6). The joints see a discrete
+// Laplacian of the spring torques whose fastest mode is about 4k; Euler keeps it when the
+// damping v dominates it over a step (v >= 4 k h) and 4 v h < 2, so
+// h <= min(v / (4 k_max), 1 / (2 v)) (v = 0: no step is stable). The joint stiffness is per
+// unit inertia, so the groom enters only through the falloff, which never exceeds k.
+StepBound forest_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity);
+
+}  // namespace hairbench::halen

@@ -1,0 +1,191 @@
+// Bring your own groom: the head sphere fitted through the shipped assets' roots agrees
+// with the built-in scenarios' hand-fitted numbers, units are read from the groom's size
+// (and refused when two fit), degenerate strands are repaired and listed or refused with
+// the strand and edge, and substeps picked from the groom keep halen_spring's edges
+// together on the mohawk, where the default count stretches them.
+#include "core/error.h"
+#include "core/groom_fit.h"
+#include "core/parallel.h"
+#include "harness/runner.h"
+#include "models/registry.h"
+#include "scenarios/groom_scenario.h"
+#include "scenarios/scenario.h"
+#include "scenarios/tfx/tfx.h"
+#include "reports/verdict.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+using namespace hairbench;
+
+namespace {
+
+const fs::path kAssets = HAIRBENCH_ASSET_DIR;
+const fs::path kMohawk = kAssets / "ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
+
+// The message of the InputError f throws ("" when it throws none).
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expect_near(const Vec3f& got, const Vec3f& want, float tol) {
+  EXPECT_LT((got - want).norm(), tol) << "got [" << got.transpose() << "], want [" << want.transpose() << "]";
+}
+
+TEST(HeadFit, AgreesWithTheBuiltInScenariosHandFits) {
+  // tressfx_mohawk: "sphere fitted through the crown's roots, y > 75 cm", head radius 13 cm.
+  const HeadFit mohawk = fit_head(tfx::read_tfx_strands(kMohawk), 75.0);
+  ASSERT_TRUE(mohawk.sphere) << mohawk.note;
+  expect_near(mohawk.center, Vec3f(-0.15f, 74.52f, 13.0f), 0.01f);
+  EXPECT_NEAR(mohawk.radius, 13.0f, 13.0f * 0.2f);
+  // tressfx_testhair1: "sphere fitted through the roots".
+  const HeadFit testhair = fit_head(tfx::read_tfx_strands(kAssets / "testhair1/TestHair1.tfxproj"));
+  ASSERT_TRUE(testhair.sphere) << testhair.note;
+  expect_near(testhair.center, Vec3f(5.33f, 10.65f, -1.85f), 0.01f);
+  // The ponytail's scenarios turn about the project's first collision sphere (26.5 cm),
+  // a rough stand-in for the head: the scalp is the same head within a fifth of it.
+  const HeadFit ponytail = fit_head(tfx::read_tfx_strands(kAssets / "ponytail/ponytail.tfxproj"));
+  ASSERT_TRUE(ponytail.sphere) << ponytail.note;
+  expect_near(ponytail.center, Vec3f(-0.095f, 92.0f, 9.899f), 26.5f * 0.25f);
+  EXPECT_NEAR(ponytail.radius, 26.5f, 26.5f * 0.25f);
+}
+
+TEST(HeadFit, RootsOnALineFallBackWithANote) {
+  Groom g;
+  for (int s = 0; s < 20; ++s) {
+    const std::vector<Vec3f> pts{{s * 5.0f, 0, 0}, {s * 5.0f, 1, 0}, {s * 5.0f, 2, 0}};
+    g.add_strand(pts, 0);
+  }
+  const HeadFit fit = fit_head(g);
+  EXPECT_FALSE(fit.sphere);
+  EXPECT_NE(fit.note.find("bounding-box centre"), std::string::npos) << fit.note;
+  EXPECT_GT(fit.radius, 0.0f);
+  // A 95-unit line is a body in cm (0.95 m) and in mm (9.5 cm): no unit is guessed.
+  EXPECT_EQ(error_of([&] { guess_unit(g, fit, "line.tfx"); }),
+            "line.tfx: unit: cannot tell the unit: the roots' bounding-box diagonal is 95 file units, which is "
+            "within [0.05, 3] m in both cm and mm; give it (--unit, or \"unit\" in the scenario file)");
+}
+
+TEST(HeadFit, UnitFollowsTheHeadsSize) {
+  Groom cm = tfx::read_tfx_strands(kMohawk);
+  EXPECT_EQ(guess_unit(cm, fit_head(cm, 75.0), "mohawk").unit, "cm");
+  // The same groom written in metres.
+  Groom m = cm;
+  for (Vec4f& p : m.positions) p.head<3>() *= 0.01f;
+  EXPECT_EQ(guess_unit(m, fit_head(m, 0.75), "mohawk_m").unit, "m");
+}
+
+// The mohawk in metres with strand 100's edge 5 made zero and strand 200's edge 7 1e-7 m
+// long (vertex i moved onto vertex i-1, or 1e-7 m from it along the edge).
+Groom damaged_mohawk() {
+  Groom g = tfx::load_tfx_asset(kMohawk, {0.01f}).groom;
+  auto squeeze = [&](std::size_t s, std::uint32_t edge, float length) {
+    Vec4f& b = g.positions[g.strand_begin(s) + edge + 1];
+    const Vec4f& a = g.positions[g.strand_begin(s) + edge];
+    const Vec3f d = (b - a).head<3>().normalized();
+    b.head<3>() = a.head<3>() + length * d;
+  };
+  squeeze(100, 5, 0.0f);
+  squeeze(200, 7, 1e-7f);
+  return g;
+}
+
+TEST(Hygiene, NearZeroEdgesAreResampledAndListed) {
+  Groom g = damaged_mohawk();
+  const std::vector<Repair> repairs = repair_groom(g, DegeneratePolicy::Repair, "mohawk");
+  ASSERT_FALSE(repairs.empty());
+  EXPECT_EQ(repairs[0].kind, "near_zero_edges");
+  EXPECT_EQ(repairs[0].strands, 2u);
+  EXPECT_EQ(repairs[0].items, 2u);
+  EXPECT_EQ(repairs[0].example, "strand 100 edge 5 (0 m)");
+  validate_groom(g, "mohawk");  // no edge left at or under 1e-7 m
+  const std::vector<float> len = rest_edge_lengths(g);
+  // Resampled strands have equal edges (chords of equal arc-length steps).
+  for (std::size_t s : {100u, 200u}) {
+    const std::uint32_t b = g.strand_begin(s);
+    EXPECT_GT(len[b + 6], 0.5f * len[b + 2]) << s;
+  }
+  EXPECT_EQ(repairs_text(repairs).rfind("repairs: 2 near-zero edges in 2 strands resampled (first: strand 100 edge 5", 0),
+            0u);
+}
+
+TEST(Hygiene, RefuseNamesTheStrandAndEdge) {
+  Groom g = damaged_mohawk();
+  EXPECT_EQ(error_of([&] { repair_groom(g, DegeneratePolicy::Refuse, "mohawk.tfx"); }),
+            "mohawk.tfx: strand 100 edge 5: near-zero rest edge of 0 m (under 0.01 of the strand's median edge; "
+            "\"degenerate\": \"repair\" resamples the strand)");
+}
+
+TEST(Hygiene, DuplicateStrandsAreRemovedAndShortOnesPinned) {
+  Groom g;
+  const std::vector<Vec3f> a{{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, b{{1, 0, 0}, {1, 1, 0}, {1, 2, 0}},
+      tiny{{2, 0, 0}, {2, 0.01f, 0}, {2, 0.02f, 0}};
+  for (const auto* s : {&a, &b, &a, &b, &tiny}) g.add_strand(*s, 0);
+  const std::vector<Repair> repairs = repair_groom(g, DegeneratePolicy::Repair, "g");
+  ASSERT_EQ(repairs.size(), 2u);
+  EXPECT_EQ(repairs[0].kind, "coincident_roots");
+  EXPECT_EQ(repairs[0].strands, 2u);
+  EXPECT_EQ(g.strand_count(), 3u);
+  EXPECT_EQ(repairs[1].kind, "short_strands");
+  EXPECT_EQ(g.positions[g.strand_begin(2) + 2].w(), 0.0f);
+}
+
+// The built-in mohawk (strands under 2 cm rigid) without its hand-set substeps.
+Scenario mohawk_without_substeps() {
+  Scenario sc = load_scenario(builtin_scenario_dir() / "tressfx_mohawk.json");
+  sc.models.erase("*");
+  sc.frames = 10;
+  return sc;
+}
+
+TEST(AutoSubsteps, KeepHalenSpringsEdgesOnTheMohawk) {
+  const Scenario sc = mohawk_without_substeps();
+  const ModelInfo& spring = *find_model("halen_spring");
+  const auto chosen = choose_substeps(spring, sc, resolve_params(spring, sc, {}), {});
+  ASSERT_TRUE(chosen);
+  EXPECT_EQ(chosen->source, "auto");
+  EXPECT_GT(chosen->value, 6);
+  EXPECT_FALSE(chosen->capped);
+  // A number given anywhere wins.
+  EXPECT_EQ(choose_substeps(spring, sc, resolve_params(spring, sc, {{"halen_spring", "substeps", 6}}),
+                            {{"halen_spring", "substeps", 6}})
+                ->source,
+            "given");
+  ThreadPool pool(2);
+  RunOptions opt;
+  opt.models = {"halen_spring"};
+  opt.probe = false;
+  EXPECT_EQ(run_scenario(sc, opt, pool).back().verdict.status, verdict::Status::ok);
+  opt.overrides = {{"halen_spring", "substeps", 6}};
+  EXPECT_EQ(run_scenario(sc, opt, pool).back().verdict.status, verdict::Status::stretched);
+}
+
+TEST(GroomScenario, FitsEverythingFromTheGroomAlone) {
+  const nlohmann::json doc = groom_scenario_json(kMohawk, kMohawk.string(), "shake", "auto", 75.0);
+  const Scenario sc = load_scenario_text(doc.dump(), fs::temp_directory_path() / "mohawk_shake.json");
+  ASSERT_TRUE(sc.import);
+  EXPECT_EQ(sc.import->unit, "cm");
+  EXPECT_EQ(sc.import->pivot_from, "fit");
+  expect_near(sc.import->pivot, Vec3f(-0.15f, 74.52f, 13.0f), 0.01f);
+  EXPECT_NEAR(sc.head_radius, 0.1515f, 1e-3f);
+  // The collider is the head sphere shrunk until no free rest vertex is inside it.
+  ASSERT_EQ(sc.colliders.size(), 1u);
+  EXPECT_LE(sc.colliders[0].radius, sc.head_radius);
+  for (const Vec4f& p : sc.groom.positions)
+    if (p.w() != 0.0f) EXPECT_GE((p.head<3>() - sc.colliders[0].center).norm(), sc.colliders[0].radius);
+  EXPECT_EQ(error_of([] { groom_scenario_json(kMohawk, "x", "moonwalk", "auto"); }).rfind(
+                "--motion: moonwalk: not a built-in scenario (one of: ", 0),
+            0u);
+}
+
+}  // namespace
