@@ -76,11 +76,11 @@ constexpr const char* kStressHelp =
     "and draws its heatmap DIR/stress_heatmap.png.";
 
 constexpr const char* kMergeHelp =
-    "merge writes one report, OUT_DIR/report.json (or stress.json)\n"
-    "with its charts, from the reports of the shards of one\n"
-    "command (--shard I/N); it refuses shards of different\n"
-    "builds, scenarios or plans, reference runs that differ,\n"
-    "duplicate runs and missing ones.";
+    "merge writes one report, OUT_DIR/report.json (or stress.json,\n"
+    "or reproduce.json) with its charts, from the reports of the\n"
+    "shards of one command (--shard I/N); it refuses shards of\n"
+    "different builds, scenarios or plans, reference runs that\n"
+    "differ, duplicate runs and missing ones.";
 
 constexpr const char* kReproduceHelp =
     "reproduce runs the papers' claims and tables\n"
@@ -514,6 +514,12 @@ struct MergeArgs {
 int cmd_merge(const MergeArgs& a) {
   std::vector<ShardReport> shards;
   for (const std::string& f : a.files) shards.push_back(read_shard_report(f));
+  if (shards.front().report["schema"] == "hairbench-reproduce") {
+    const nlohmann::json merged = merge_reproduce_reports(shards);
+    std::printf("merged %zu reproduce shards of %d (%zu papers)\n", shards.size(), merged["merge"]["count"].get<int>(),
+                merged["papers"].size());
+    return write_reproduce(merged, a.out, a.charts);
+  }
   const bool stress = shards.front().report.contains("stress");
   const nlohmann::json merged = stress ? merge_stress_reports(shards) : merge_reports(shards, a.mix_machines);
   const std::filesystem::path file = std::filesystem::path(a.out) / (stress ? "stress.json" : "report.json");
@@ -538,19 +544,31 @@ struct ReproduceShard {
   bool plan_only = false;
 };
 
-bool shard_papers(std::vector<std::string>& papers, const ReproduceShard& rs) {
+bool shard_papers(ReproduceOptions& opt, const ReproduceShard& rs) {
   if (rs.arg.empty() && !rs.plan_only) return true;
   const ShardSpec shard = rs.arg.empty() ? ShardSpec{1, 1} : parse_shard(rs.arg);
+  std::vector<std::string>& papers = opt.papers;
+  const nlohmann::json frames_cap = opt.frames > 0 ? nlohmann::json(opt.frames) : nlohmann::json(nullptr);
+  Plan plan;
+  plan.count = shard.count;
+  plan.shard_seconds.assign(static_cast<std::size_t>(shard.count), 0.0);
+  plan.cost_source = "whole papers, in turn";
   std::vector<std::string> mine;
-  for (std::size_t i = 0; i < papers.size(); ++i)
-    if (static_cast<int>(i % static_cast<std::size_t>(shard.count)) + 1 == shard.index) mine.push_back(papers[i]);
+  for (std::size_t i = 0; i < papers.size(); ++i) {
+    PlanItem item;
+    item.key = reproduce_plan_key(papers[i], frames_cap);
+    item.label = papers[i];
+    item.shard = static_cast<int>(i % static_cast<std::size_t>(shard.count)) + 1;
+    if (item.shard == shard.index) mine.push_back(papers[i]);
+    plan.items.push_back(std::move(item));
+  }
   if (rs.plan_only) {
     std::printf("reproduce: %zu papers, %d shard%s; whole papers (no cost estimate: a paper is not a run list)\n",
                 papers.size(), shard.count, shard.count == 1 ? "" : "s");
     for (int s = 1; s <= shard.count; ++s) {
       std::string list;
-      for (std::size_t i = 0; i < papers.size(); ++i)
-        if (static_cast<int>(i % static_cast<std::size_t>(shard.count)) + 1 == s) list += " " + papers[i];
+      for (const PlanItem& it : plan.items)
+        if (it.shard == s) list += " " + it.label;
       std::printf("shard %d/%d:%s\n", s, shard.count, list.empty() ? " (none)" : list.c_str());
     }
     return false;
@@ -561,6 +579,7 @@ bool shard_papers(std::vector<std::string>& papers, const ReproduceShard& rs) {
     return false;
   }
   papers = std::move(mine);
+  opt.shard = shard_json(plan, shard);
   return true;
 }
 
@@ -850,7 +869,7 @@ int run(int argc, char** argv) {
   if (scenario_new->parsed()) return cmd_scenario_new(new_groom, new_motion, new_unit, new_fit_above, new_out);
   if (reproduce->parsed()) {
     reproduce_opt.papers = select_papers(tables);
-    if (!shard_papers(reproduce_opt.papers, reproduce_shard)) return 0;
+    if (!shard_papers(reproduce_opt, reproduce_shard)) return 0;
     return cmd_reproduce(reproduce_opt);
   }
   throw InputError("arguments", "hairbench",

@@ -1,6 +1,7 @@
 #include "harness/merge.h"
 
 #include "core/error.h"
+#include "harness/reproduce.h"
 #include "harness/shard.h"
 #include "harness/stress.h"
 #include "reports/report.h"
@@ -21,10 +22,12 @@ ShardReport read_shard_report(const std::string& file) {
   if (!in) throw InputError("merge", file, "cannot read the shard report");
   json j = json::parse(in, nullptr, false);
   if (j.is_discarded() || !j.is_object()) throw InputError("merge", file, "not a JSON object");
-  if (j.value("schema", "") != "hairbench-report") throw InputError(file, "schema", "not a hairbench-report");
+  if (j.value("schema", "") != "hairbench-report" && j.value("schema", "") != "hairbench-reproduce")
+    throw InputError(file, "schema", "not a hairbench-report or hairbench-reproduce");
   const json& s = j.value("shard", json());
   if (!s.is_object())
-    throw InputError(file, "shard", "missing: not the report of a shard (run compare, sweep or stress with --shard I/N)");
+    throw InputError(file, "shard",
+                     "missing: not the report of a shard (run compare, sweep, stress or reproduce with --shard I/N)");
   auto bad = [&](const char* field, const char* what) { return InputError(file, std::string("shard.") + field, what); };
   if (!s.contains("index") || !s["index"].is_number_integer()) throw bad("index", "missing or not a whole number");
   if (!s.contains("count") || !s["count"].is_number_integer()) throw bad("count", "missing or not a whole number");
@@ -288,6 +291,33 @@ json merge_stress_reports(const std::vector<ShardReport>& in) {
   report["stress"] = stress_json(result);
   report["merge"] = merge_section(in, false);
   return report;
+}
+
+json merge_reproduce_reports(const std::vector<ShardReport>& in) {
+  for (const ShardReport& s : in)
+    if (s.report["schema"] != in.front().report["schema"])
+      throw InputError(s.file, "schema", "a " + s.report["schema"].get<std::string>() + " among " +
+                                             in.front().report["schema"].get<std::string>() + " shards");
+  const auto keys_of = [](const json& r) {
+    std::vector<std::string> keys;
+    for (const json& p : r["papers"]) keys.push_back(reproduce_plan_key(p["id"], r["frames_cap"]));
+    return keys;
+  };
+  json papers = json::array();
+  double wall_s = 0.0;
+  for (const auto& [key, i] : check_shards(in, keys_of))
+    for (const json& p : in[i].report["papers"])
+      if (reproduce_plan_key(p["id"], in[i].report["frames_cap"]) == key) papers.push_back(p);
+  for (const ShardReport& s : in) wall_s += s.report.value("wall_s", 0.0);
+  return {{"schema", "hairbench-reproduce"},
+          {"schema_version", in.front().report["schema_version"]},
+          {"context", merged_context(in)},
+          {"papers", papers},
+          {"frames_cap", in.front().report["frames_cap"]},
+          {"load_average", {{"start", nullptr}, {"end", nullptr}}},
+          {"wall_s", wall_s},
+          {"summary", reproduce_summary(papers)},
+          {"merge", merge_section(in, false)}};
 }
 
 }  // namespace hairbench

@@ -35,4 +35,9 @@ nlohmann::json merge_reports(const std::vector<ShardReport>& shards, bool mix_ma
 // and the degenerate grooms, each axis's first failure decided again over all its cells.
 nlohmann::json merge_stress_reports(const std::vector<ShardReport>& shards);
 
+// The same for `hairbench reproduce --shard` reports (reproduce.json): the shards' papers
+// in the plan's order, the summary counted again over all of them, each shard's context
+// under "merge" (a paper's rows are measured in one process, on one machine).
+nlohmann::json merge_reproduce_reports(const std::vector<ShardReport>& shards);
+
 }  // namespace hairbench

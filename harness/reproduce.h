@@ -23,7 +23,14 @@ struct ReproduceOptions {
   std::string device;               // Vulkan device for Han & Harada's GPU table
   std::filesystem::path out = "reports/out/reproduce";
   bool charts = true;               // --no-charts: no claim charts
+  // With --shard I/N: the report's `shard` object (harness/shard.h's shard_json over the
+  // papers, each a plan item keyed by reproduce_plan_key), which hairbench merge reads.
+  nlohmann::json shard = nullptr;
 };
+
+// A paper's key in a sharded reproduce's plan: the paper, and the frame cap, so that
+// shards run with different caps are of different plans and never merged.
+std::string reproduce_plan_key(const std::string& paper, const nlohmann::json& frames_cap);
 
 // The tables named on the command line (each of kReproducePapers or "all") as
 // ReproduceOptions::papers, in kReproducePapers order; throws InputError naming a bad one.
@@ -37,8 +44,15 @@ nlohmann::json run_reproduce(const ReproduceOptions& opt, const std::function<vo
 std::string reproduce_markdown(const nlohmann::json& report);
 std::string reproduce_html(const nlohmann::json& report, const std::filesystem::path& charts_dir);
 
-// The command: run, write OUT/reproduce.json, draw the claims' charts into OUT/charts/,
-// write OUT/reproduce.{md,html}, print the three kinds of rows.
+// The counts of a report's `summary`: setups by match, claims by verdict, measurements.
+nlohmann::json reproduce_summary(const nlohmann::json& papers);
+
+// Writes OUT/reproduce.json, draws the claims' charts into OUT/charts/ (unless `charts`
+// is false), writes OUT/reproduce.{md,html} and prints the three kinds of rows. Returns
+// the chart step's exit code.
+int write_reproduce(const nlohmann::json& report, const std::filesystem::path& out, bool charts);
+
+// The command: run, then write_reproduce.
 int cmd_reproduce(const ReproduceOptions& opt);
 
 }  // namespace hairbench

@@ -302,4 +302,39 @@ TEST(ReproduceShards, PlanCutsWholePapers) {
             "shard 2/2: halen2007\n");
 }
 
+// reproduce shards merge into one report: every paper once, in the plan's order, the
+// summary counted over all of them; a missing paper and a shard of another frame cap
+// are refused.
+TEST(ReproduceShards, MergedHoldsEveryPaperOnce) {
+  const fs::path dir = fresh_dir("hairbench-reproduce-shard-test");
+  const std::string cmd = "reproduce halen2007 plante2001 --threads 2 --no-charts";
+  for (int i = 1; i <= 2; ++i) {
+    const std::string out = (dir / ("s" + std::to_string(i))).string();
+    ASSERT_EQ(run_cli(cmd + " --frames 2 --shard " + std::to_string(i) + "/2 --out " + out, "", "2>/dev/null").code, 0);
+  }
+  ASSERT_EQ(run_cli(cmd + " --frames 3 --shard 2/2 --out " + (dir / "other_cap").string(), "", "2>/dev/null").code, 0);
+  const std::string s1 = (dir / "s1" / "reproduce.json").string(), s2 = (dir / "s2" / "reproduce.json").string();
+  const hairbench::test::CliResult r = run_cli("merge " + (dir / "m").string() + " --no-charts " + s2 + " " + s1);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const json merged = read(dir / "m" / "reproduce.json");
+  ASSERT_EQ(merged["papers"].size(), 2u);
+  EXPECT_EQ(merged["papers"][0], read(s1)["papers"][0]);
+  EXPECT_EQ(merged["papers"][1], read(s2)["papers"][0]);
+  for (const char* kind : {"holds", "differs", "not_testable"})
+    EXPECT_EQ(merged["summary"]["claims"][kind].get<int>(),
+              read(s1)["summary"]["claims"][kind].get<int>() + read(s2)["summary"]["claims"][kind].get<int>())
+        << kind;
+  EXPECT_TRUE(fs::exists(dir / "m" / "reproduce.html"));
+
+  const hairbench::test::CliResult missing = run_cli("merge " + (dir / "m2").string() + " --no-charts " + s1);
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(missing.out,
+            "hairbench: merge: runs: 1 of 2 runs of the plan are missing, from shard 2/2 (not given): plante2001 "
+            "--frames 2\n");
+  const hairbench::test::CliResult cap =
+      run_cli("merge " + (dir / "m3").string() + " --no-charts " + s1 + " " + (dir / "other_cap" / "reproduce.json").string());
+  EXPECT_EQ(cap.code, 2);
+  EXPECT_NE(cap.out.find("shard.plan_hash"), std::string::npos) << cap.out;
+}
+
 }  // namespace

@@ -28,8 +28,9 @@ json load_average() {
   return std::isfinite(l) ? json(l) : json(nullptr);
 }
 
-// Counts per kind: setups by match, claims by verdict, measurements by number.
-json summary(const json& papers) {
+}  // namespace
+
+json reproduce_summary(const json& papers) {
   int matches = 0, mismatches = 0, holds = 0, differs = 0, untestable = 0, measurements = 0;
   for (const json& p : papers) {
     for (const json& r : p["setups"]) (r["verdict"] == "matches" ? matches : mismatches)++;
@@ -44,7 +45,9 @@ json summary(const json& papers) {
           {"measurements", measurements}};
 }
 
-}  // namespace
+std::string reproduce_plan_key(const std::string& paper, const json& frames_cap) {
+  return frames_cap.is_null() ? paper : paper + " --frames " + frames_cap.dump();
+}
 
 std::vector<std::string> select_papers(const std::vector<std::string>& names) {
   auto named = [&](const std::string& p) { return std::find(names.begin(), names.end(), p) != names.end(); };
@@ -75,8 +78,23 @@ json run_reproduce(const ReproduceOptions& opt, const std::function<void(const s
   report["frames_cap"] = opt.frames > 0 ? json(opt.frames) : json(nullptr);
   report["load_average"] = {{"start", load_start}, {"end", load_average()}};
   report["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  report["summary"] = summary(papers);
+  report["summary"] = reproduce_summary(papers);
+  if (!opt.shard.is_null()) report["shard"] = opt.shard;
   return report;
+}
+
+int write_reproduce(const json& report, const std::filesystem::path& out, bool charts) {
+  const std::filesystem::path json_file = out / "reproduce.json";
+  write_json(json_file, report);
+  int chart_status = 0;
+  if (charts) chart_status = draw_charts(json_file, "reproduce_charts.py");
+  const std::string md = reproduce_markdown(report);
+  std::ofstream(out / "reproduce.md") << md;
+  std::ofstream(out / "reproduce.html") << reproduce_html(report, out / "charts");
+  // The terminal gets the three summary tables, not the per-paper detail.
+  std::fputs(md.substr(0, md.find("\n## Details")).c_str(), stdout);
+  std::printf("\nwrote %s (.md, .html%s)\n", json_file.string().c_str(), charts ? ", charts/" : "");
+  return chart_status;
 }
 
 int cmd_reproduce(const ReproduceOptions& opt) {
@@ -85,17 +103,7 @@ int cmd_reproduce(const ReproduceOptions& opt) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "[%6.1f s] %s\n", s, line.c_str());
   });
-  const std::filesystem::path json_file = opt.out / "reproduce.json";
-  write_json(json_file, report);
-  int chart_status = 0;
-  if (opt.charts) chart_status = draw_charts(json_file, "reproduce_charts.py");
-  const std::string md = reproduce_markdown(report);
-  std::ofstream(opt.out / "reproduce.md") << md;
-  std::ofstream(opt.out / "reproduce.html") << reproduce_html(report, opt.out / "charts");
-  // The terminal gets the three summary tables, not the per-paper detail.
-  std::fputs(md.substr(0, md.find("\n## Details")).c_str(), stdout);
-  std::printf("\nwrote %s (.md, .html%s)\n", json_file.string().c_str(), opt.charts ? ", charts/" : "");
-  return chart_status;
+  return write_reproduce(report, opt.out, opt.charts);
 }
 
 }  // namespace hairbench
