@@ -140,6 +140,19 @@ HeadFit fit_head(const Groom& g, std::optional<double> above) {
     else if (s.r > kSphereSpread * spread)
       fit.note = "the roots are nearly flat (the best sphere is " + text(s.r / spread) + " times their spread)";
     else fit.sphere = true;
+    if (fit.sphere) {
+      Vec3d dir = Vec3d::Zero();
+      for (std::size_t i = 0; i < n; ++i)
+        if (use[i] && (roots[i] - s.c).norm() > 0.0) dir += (roots[i] - s.c).normalized();
+      fit.cap = (dir / static_cast<double>(used)).norm();
+      if (fit.rms_residual > kScalpResidual * s.r)
+        fit.note = "not a scalp, so not used for the unit: the roots are " + text(fit.rms_residual / s.r) +
+                   " of its radius off it (a scalp, above " + text(kScalpResidual) + ")";
+      else if (fit.cap < kScalpCap)
+        fit.note = "not a scalp, so not used for the unit: the roots lie all round it (mean direction " +
+                   text(fit.cap, 2) + ", a scalp's cap " + text(kScalpCap) + " or more)";
+      else fit.scalp = true;
+    }
   } else {
     fit.note = used < 4 ? "fewer than 4 roots" : "the roots lie on a plane or a line";
   }
@@ -160,37 +173,111 @@ HeadFit fit_head(const Groom& g, std::optional<double> above) {
 
 float metres_per_unit(const std::string& unit) { return unit == "cm" ? 0.01f : unit == "mm" ? 0.001f : 1.0f; }
 
-UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source) {
-  double size = fit.radius;
-  double lo = kHeadRadiusMin, hi = kHeadRadiusMax;
-  std::string what = "head radius";
-  if (!fit.sphere) {
-    Vec3d a = Vec3d::Constant(std::numeric_limits<double>::max()), b = -a;
-    for (std::size_t s = 0; s < g.strand_count(); ++s) {
-      a = a.cwiseMin(root_of(g, s));
-      b = b.cwiseMax(root_of(g, s));
-    }
-    size = (b - a).norm();
-    lo = kRootSpanMin;
-    hi = kRootSpanMax;
-    what = "roots' bounding-box diagonal";
+namespace {
+
+// The median distance from a root to its nearest other root (coincident roots left
+// out), over a uniform grid of cells about the roots' mean spacing on a surface; a root
+// with no neighbour in the 27 cells about it counts as one cell away (a lower bound).
+double median_root_spacing(const std::vector<Vec3d>& roots, double span) {
+  const std::size_t n = roots.size();
+  if (n < 2 || !(span > 0.0)) return 0.0;
+  const double cell = span / std::sqrt(static_cast<double>(n));
+  Vec3d lo = roots[0];
+  for (const Vec3d& r : roots) lo = lo.cwiseMin(r);
+  const auto key = [&](long x, long y, long z) {
+    return (static_cast<std::uint64_t>(x) * 73856093ull) ^ (static_cast<std::uint64_t>(y) * 19349663ull) ^
+           (static_cast<std::uint64_t>(z) * 83492791ull);
+  };
+  const auto coords = [&](const Vec3d& r) {
+    const Vec3d c = ((r - lo) / cell).array().floor();
+    return std::array<long, 3>{static_cast<long>(c.x()), static_cast<long>(c.y()), static_cast<long>(c.z())};
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;
+  grid.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = coords(roots[i]);
+    grid[key(c[0], c[1], c[2])].push_back(static_cast<std::uint32_t>(i));
   }
+  std::vector<double> nearest;
+  nearest.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = coords(roots[i]);
+    double best = std::numeric_limits<double>::infinity();
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(key(c[0] + dx, c[1] + dy, c[2] + dz));
+          if (it == grid.end()) continue;
+          for (std::uint32_t j : it->second) {
+            const double d = (roots[j] - roots[i]).norm();
+            if (j != i && d > 0.0) best = std::min(best, d);
+          }
+        }
+    nearest.push_back(std::min(best, cell));
+  }
+  return median(std::move(nearest));
+}
+
+// One cue of the unit: a size in file units and the range in metres that real hair on
+// a real head gives it.
+struct Cue {
+  std::string what;
+  double size;
+  double lo, hi;
+  std::vector<std::string> admits;
+};
+
+}  // namespace
+
+UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source) {
+  std::vector<Vec3d> roots(g.strand_count());
+  Vec3d a = Vec3d::Constant(std::numeric_limits<double>::max()), b = -a;
+  std::vector<double> lengths(g.strand_count()), e;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    roots[s] = root_of(g, s);
+    a = a.cwiseMin(roots[s]);
+    b = b.cwiseMax(roots[s]);
+    edge_lengths(g, s, e);
+    for (double l : e) lengths[s] += l;
+  }
+  const double span = g.strand_count() ? (b - a).norm() : 0.0;
+  std::vector<Cue> cues;
+  if (fit.scalp) cues.push_back({"head radius", fit.radius, kHeadRadiusMin, kHeadRadiusMax, {}});
+  cues.push_back({"median strand", median(lengths), kStrandLengthMin, kStrandLengthMax, {}});
+  cues.push_back({"roots' span", span, kRootSpanMin, kRootSpanMax, {}});
+  cues.push_back({"root spacing", median_root_spacing(roots, span), kRootSpacingMin, kRootSpacingMax, {}});
   std::vector<std::string> fits;
   for (const char* unit : {"m", "cm", "mm"}) {
-    const double m = size * metres_per_unit(unit);
-    if (m >= lo && m < hi) fits.emplace_back(unit);  // half-open: ranges under 10x never match two units
+    bool all = true;
+    for (Cue& c : cues) {
+      const double m = c.size * metres_per_unit(unit);
+      // Half-open, so that a range under 10x wide never admits two units at its ends.
+      if (m >= c.lo && m < c.hi) c.admits.emplace_back(unit);
+      else all = false;
+    }
+    if (all) fits.emplace_back(unit);
   }
-  const std::string range = "[" + text(lo) + ", " + text(hi) + "] m";
+  std::string sizes;
+  for (const Cue& c : cues) {
+    std::string admits;
+    for (std::size_t i = 0; i < c.admits.size(); ++i)
+      admits += (i == 0 ? "" : i + 1 == c.admits.size() ? " or " : ", ") + c.admits[i];
+    sizes += (sizes.empty() ? "" : ", ") + c.what + " " + text(c.size, 4) + " (" + text(c.lo) + "-" + text(c.hi) +
+             " m: " + (admits.empty() ? "no unit" : admits) + ")";
+  }
   if (fits.size() != 1)
     throw InputError(source, "unit",
-                     "cannot tell the unit: the " + what + " is " + text(size, 4) + " file units, which is " +
-                         (fits.empty() ? "outside " + range + " in m, cm and mm"
-                                       : "within " + range + " in both " + fits[0] + " and " + fits[1]) +
-                         "; give it (--unit, or \"unit\" in the scenario file)");
+                     std::string("cannot tell the unit: ") +
+                         (fits.empty() ? "no unit fits every cue" : "both " + fits[0] + " and " + fits[1] + " fit") +
+                         " [file units: " + sizes + "]; give it (--unit, or \"unit\" in the scenario file)" +
+                         (fits.empty() && fit.scalp && fit.note.empty()
+                              ? ", or fit the head on the scalp's roots only (--fit-above, \"fit_above\")"
+                              : ""));
   UnitGuess out;
   out.unit = fits[0];
   out.metres_per_unit = metres_per_unit(out.unit);
-  out.why = what + " " + text(size, 4) + " file units = " + text(size * out.metres_per_unit) + " m";
+  out.why = cues.front().what + " " + text(cues.front().size, 4) + " file units = " +
+            text(cues.front().size * out.metres_per_unit) + " m; every cue: " + sizes;
   return out;
 }
 

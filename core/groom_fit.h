@@ -23,33 +23,67 @@ struct HeadFit {
   // roots is at most kSphereResidual of its radius and its radius at most kSphereSpread
   // times the roots' own spread. Otherwise (a fur groom on a body, roots on a plane or a
   // line) center is the roots' bounding-box centre, radius a sphere inside their box
-  // (never 0), and `note` says why.
+  // (never 0), and `note` says why. A sphere is the pivot and the collider.
   bool sphere = false;
+  // Whether that sphere is a scalp, and so its radius evidence of the unit (guess_unit):
+  // the residual is at most kScalpResidual of the radius and the roots cover a cap of it
+  // (`cap` at least kScalpCap). A sphere that is not a scalp (TestHair1's roots all round
+  // a 64-unit ball, 0.15 of its radius off it) still gives the pivot; `note` says why it
+  // was not used for the unit.
+  bool scalp = false;
   double rms_residual = 0.0;  // RMS of |p - c| - r over the roots, in the groom's units
+  double cap = 0.0;           // |mean of (p - c) / |p - c||: 1 for one point, 0 all round
   std::string note;
 };
 
 inline constexpr double kSphereResidual = 0.2;
 inline constexpr double kSphereSpread = 4.0;
+// A human scalp is an ellipsoid, not a sphere: adult proportions (half-breadth 7-8 cm,
+// half-length 9.8-11 cm, crown height 10-13 cm) cut anywhere from 0.3 of the height below
+// the ears' level to 0.3 above it deviate from their best sphere by 0.064-0.098 of its
+// radius RMS (uniform roots), the ponytail asset's stylised head by 0.11, the mohawk's
+// crown by 0.063. 1/8 admits them all; TestHair1's 0.155 is not a head.
+inline constexpr double kScalpResidual = 0.125;
+// The same scalps cover a cap: the mean unit direction from the centre is 0.23-0.59 long
+// (0.40 on the ponytail, 0.83 on the mohawk's crown); roots all round a sphere give about
+// 0 (TestHair1: 0.04).
+inline constexpr double kScalpCap = 0.15;
 
 // Least squares: |p|^2 = 2 c.p + (r^2 - |c|^2) is linear in (c, r^2 - |c|^2), solved in
 // double precision over the roots, centred on their mean for conditioning.
 HeadFit fit_head(const Groom& g, std::optional<double> above = std::nullopt);
 
-// The unit of a groom from its size, in metres per file unit: the one of cm, mm and m
-// under which the fitted head radius (or, without a sphere, the roots' bounding-box
-// diagonal) is human-sized. Throws InputError naming `source` and "unit" when no unit or
-// more than one fits (the message gives the size and the accepted ranges).
+// The unit of a groom from its size, in metres per file unit. Each cue below admits the
+// units (m, cm, mm) under which its size is that of real hair on a real head, and the
+// unit is the one every cue admits (docs/groom-import.md, "Units"):
+//  - the head radius, when the fitted sphere is a scalp (HeadFit::scalp);
+//  - the median strand length: hair long enough to be simulated, and no longer than hair;
+//  - the roots' bounding-box diagonal: a palm-sized patch to a body;
+//  - the median distance from a root to its nearest neighbour: guides no denser than
+//    hair follicles, and close enough to cover a scalp.
+// Throws InputError naming `source` and "unit" when no unit or more than one passes
+// every cue (the message gives each cue's size and the units it admits, and says --unit).
 struct UnitGuess {
   std::string unit;  // "cm", "mm" or "m"
   float metres_per_unit = 0.0f;
-  std::string why;  // the size it was read from, for the terminal and the report
+  std::string why;  // the sizes it was read from, for the terminal and the report
 };
 UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source);
-// Head radii in metres that identify a unit: a child's head to a helmet.
+// Head radii in metres: a child's head to a helmet (and the ponytail asset's outsized
+// 32 cm head).
 inline constexpr double kHeadRadiusMin = 0.04, kHeadRadiusMax = 0.4;
-// Without a sphere: the roots' bounding-box diagonal, a palm-sized patch to a body.
+// Median strand length in metres. Below 2 cm hair hardly moves: a hair held at its root
+// sags under its weight by (L/L_g)^3/8 of its length, L_g = (E I / (rho A g))^(1/3) about
+// 5 cm for a human hair (E 4 GPa, 40 um radius, 1.3 g/cm^3), so 0.8% at 2 cm; a groom
+// whose median strand is that short is not one to simulate. Above 2 m it is not hair.
+inline constexpr double kStrandLengthMin = 0.02, kStrandLengthMax = 2.0;
+// The roots' bounding-box diagonal: a palm-sized patch to a body.
 inline constexpr double kRootSpanMin = 0.05, kRootSpanMax = 3.0;
+// Median nearest-neighbour distance between roots (coincident roots left out). A scalp
+// carries at most about 300 hairs/cm^2, whose nearest neighbours are about
+// 0.5/sqrt(300/cm^2) = 0.3 mm apart; guides are a subset of the hairs (0.1 mm allows
+// clustered exports). Over 5 cm apart, a whole scalp (about 600 cm^2) has some 25 guides.
+inline constexpr double kRootSpacingMin = 1e-4, kRootSpacingMax = 0.05;
 float metres_per_unit(const std::string& unit);
 
 // ---- import hygiene ------------------------------------------------------------------

@@ -612,6 +612,8 @@ void LockstepRun::record_scenario(int frames) const {
                  {"repairs", std::move(repairs)}};
     if (im.fitted)
       out.groom["fit"] = {{"sphere", im.fit.sphere},
+                          {"scalp", im.fit.scalp},
+                          {"cap", im.fit.cap},
                           {"center_m", {im.fit.center.x(), im.fit.center.y(), im.fit.center.z()}},
                           {"radius_m", im.fit.radius},
                           {"rms_residual_m", im.fit.rms_residual},

@@ -94,7 +94,8 @@ std::string import_summary(const Scenario& sc) {
      << "] file units (" << im.pivot_from;
   if (im.fitted) {
     if (im.fit.sphere)
-      os << ": sphere through the roots, RMS residual " << text(im.fit.rms_residual * 1e3, "%.2g") << " mm";
+      os << ": sphere through the roots, RMS residual " << text(im.fit.rms_residual * 1e3, "%.3g") << " mm"
+         << (im.fit.scalp ? "" : "; " + im.fit.note);
     else
       os << ": no sphere, " << im.fit.note;
   }

@@ -335,4 +335,93 @@ TEST(Cli, ChartStepSaysHowToDrawLater) {
   EXPECT_NE(r.out.find("charts.py " + (out / "report.json").string()), std::string::npos) << r.out;
 }
 
+
+// ---- compare --groom and scenario new (docs/groom-import.md) ---------------------------
+
+const std::string kMohawkTfx = std::string(HAIRBENCH_ASSET_DIR) + "/ratboy_mohawk_v4.0/Ratboy_mohawk.tfx";
+const std::string kTestHair1 = std::string(HAIRBENCH_ASSET_DIR) + "/testhair1/TestHair1.tfxproj";
+
+// Every refusal of a groom run: exit 2, one line that names what is wrong, and nothing
+// written.
+TEST(Cli, GroomErrorsAreOneLine) {
+  const std::string out = " --out /tmp/hairbench-cli-groom-bad";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"compare --groom /no/such/groom.tfx" + out, "--groom: /no/such/groom.tfx: no such file"},
+      {"compare --groom " + kMohawkTfx + " --scenario shake" + out,
+       "arguments: --groom: give either --groom or --scenario, not both"},
+      {"compare --motion shake --models han_m1" + out, "arguments: --motion: applies to --groom only"},
+      {"compare --unit cm --models han_m1" + out, "arguments: --unit: applies to --groom only"},
+      {"compare --groom " + kMohawkTfx + " --unit furlong" + out, "arguments: --unit: 'furlong' is not cm, mm, m or auto"},
+      {"compare --groom " + kMohawkTfx + " --motion moonwalk" + out, "--motion: moonwalk: not a built-in scenario"},
+      // All the mohawk's roots (down the neck) fit a head in mm; its strands are hair in cm.
+      {"compare --groom " + kMohawkTfx + out, kMohawkTfx + ": unit: cannot tell the unit: no unit fits every cue"},
+      {"compare --groom " + std::string(HAIRBENCH_TEST_DATA_DIR) + "/reports/tiny_shake.json" + out,
+       "expected a TressFX .tfx or .tfxproj file"},
+      {"scenario new --groom /no/such/groom.tfx --out /tmp/hairbench-cli-groom.json",
+       "--groom: /no/such/groom.tfx: no such file"},
+      {"scenario new --groom " + kMohawkTfx + " --out /tmp/hairbench-cli-groom.txt",
+       "--out: /tmp/hairbench-cli-groom.txt: expected a .json file name"},
+      {"scenario new --groom " + kMohawkTfx + " --out /tmp/hairbench-cli-groom.json",
+       "unit: cannot tell the unit"}};
+  std::filesystem::remove("/tmp/hairbench-cli-groom.json");
+  for (const auto& [args, expected] : cases) {
+    const hairbench::test::CliResult r = run_cli(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.out;
+    EXPECT_EQ(count_lines(r.out), 1) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(expected), std::string::npos) << args << ": expected '" << expected << "' in: " << r.out;
+    EXPECT_EQ(r.out.rfind("hairbench: ", 0), 0u) << r.out;
+  }
+  // A refused unit says how to give it.
+  EXPECT_NE(run_cli("compare --groom " + kMohawkTfx + out).out.find("--unit"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists("/tmp/hairbench-cli-groom.json"));
+}
+
+// compare --groom with no scenario file prints what it fitted and runs; substeps are
+// picked from the groom unless a number is given, which wins; scenario new writes the
+// same as a file that compare --scenario runs.
+TEST(Cli, CompareGroomFitsRunsAndScenarioNewWrites) {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-groom";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);
+  const std::string run = "compare --groom " + kTestHair1 +
+                          " --motion shake --models 'han_m1|halen_spring' --frames 2 --threads 2 --no-charts";
+  const hairbench::test::CliResult r = run_cli(run + " --out " + (out / "auto").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* line : {"unit cm (guessed: median strand 11 file units = 0.11 m", "pivot [5.326, 10.65, -1.855]",
+                           "not a scalp", "head radius", "colliders: r", "repairs:", "substeps ", "(auto; ",
+                           "time: load"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << " in: " << r.out;
+  const nlohmann::json a = read_report(out / "auto");
+  ASSERT_EQ(a["runs"].size(), 2u);
+  EXPECT_EQ(a["runs"][1]["model"], "halen_spring");
+  EXPECT_EQ(a["runs"][1]["substeps"]["source"], "auto");
+  EXPECT_GE(a["runs"][1]["substeps"]["value"].get<int>(), 6);  // never under the model's default
+  EXPECT_EQ(a["scenarios"][0]["groom"]["unit"], "cm");
+  EXPECT_EQ(a["scenarios"][0]["groom"]["fit"]["scalp"], false);
+
+  // A number given with --set wins over the bound, even a smaller one.
+  const hairbench::test::CliResult given =
+      run_cli(run + " --set halen_spring.substeps=3 --out " + (out / "given").string());
+  ASSERT_EQ(given.code, 0) << given.out;
+  const nlohmann::json g = read_report(out / "given");
+  EXPECT_EQ(g["runs"][1]["substeps"]["source"], "given");
+  EXPECT_EQ(g["runs"][1]["substeps"]["value"], 3);
+  EXPECT_EQ(g["runs"][1]["params"]["substeps"], 3);
+
+  const std::filesystem::path file = out / "th1_nod.json";
+  const hairbench::test::CliResult made =
+      run_cli("scenario new --groom " + kTestHair1 + " --motion nod --out " + file.string());
+  ASSERT_EQ(made.code, 0) << made.out;
+  EXPECT_NE(made.out.find("wrote " + file.string()), std::string::npos) << made.out;
+  std::ifstream in(file);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  EXPECT_EQ(doc["groom"]["unit"], "cm");  // resolved, so that the file does not guess again
+  EXPECT_EQ(doc["groom"]["pivot"], "fit");
+  EXPECT_EQ(doc["head"]["radius"], "fit");
+  const hairbench::test::CliResult ran = run_cli("compare --scenario " + file.string() +
+                                                 " --models han_m1 --frames 1 --no-charts --out " +
+                                                 (out / "file").string());
+  EXPECT_EQ(ran.code, 0) << ran.out;
+}
+
 }  // namespace

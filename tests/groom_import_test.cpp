@@ -63,17 +63,19 @@ TEST(HeadFit, AgreesWithTheBuiltInScenariosHandFits) {
 TEST(HeadFit, RootsOnALineFallBackWithANote) {
   Groom g;
   for (int s = 0; s < 20; ++s) {
-    const std::vector<Vec3f> pts{{s * 5.0f, 0, 0}, {s * 5.0f, 1, 0}, {s * 5.0f, 2, 0}};
+    const std::vector<Vec3f> pts{{s * 5.0f, 0, 0}, {s * 5.0f, 15, 0}, {s * 5.0f, 30, 0}};
     g.add_strand(pts, 0);
   }
   const HeadFit fit = fit_head(g);
   EXPECT_FALSE(fit.sphere);
   EXPECT_NE(fit.note.find("bounding-box centre"), std::string::npos) << fit.note;
   EXPECT_GT(fit.radius, 0.0f);
-  // A 95-unit line is a body in cm (0.95 m) and in mm (9.5 cm): no unit is guessed.
+  // 30-unit strands 5 units apart on a 95-unit line: hair on a body in cm (30 cm strands,
+  // 0.95 m) and in mm (3 cm strands, 9.5 cm): no unit is guessed.
   EXPECT_EQ(error_of([&] { guess_unit(g, fit, "line.tfx"); }),
-            "line.tfx: unit: cannot tell the unit: the roots' bounding-box diagonal is 95 file units, which is "
-            "within [0.05, 3] m in both cm and mm; give it (--unit, or \"unit\" in the scenario file)");
+            "line.tfx: unit: cannot tell the unit: both cm and mm fit [file units: median strand 30 (0.02-2 m: cm or "
+            "mm), roots' span 95 (0.05-3 m: cm or mm), root spacing 5 (0.0001-0.05 m: cm or mm)]; give it (--unit, "
+            "or \"unit\" in the scenario file)");
 }
 
 TEST(HeadFit, UnitFollowsTheHeadsSize) {
@@ -83,6 +85,32 @@ TEST(HeadFit, UnitFollowsTheHeadsSize) {
   Groom m = cm;
   for (Vec4f& p : m.positions) p.head<3>() *= 0.01f;
   EXPECT_EQ(guess_unit(m, fit_head(m, 0.75), "mohawk_m").unit, "m");
+}
+
+// Every shipped asset gives its built-in scenarios' unit (cm), or a refusal that says
+// --unit: never another unit.
+TEST(HeadFit, ShippedAssetsGiveTheirBuiltInUnitOrARefusal) {
+  const Groom ponytail = tfx::read_tfx_strands(kAssets / "ponytail/ponytail.tfxproj");
+  const HeadFit pfit = fit_head(ponytail);
+  EXPECT_TRUE(pfit.scalp) << pfit.note;  // 0.11 of its radius off, a cap (0.40)
+  EXPECT_EQ(guess_unit(ponytail, pfit, "ponytail").unit, "cm");
+  // TestHair1's roots lie all round a 64-unit ball, 0.15 of its radius off it: a pivot
+  // (the built-in's), not a head. Its 11-unit strands are 1.1 cm in mm: too short.
+  const Groom testhair = tfx::read_tfx_strands(kAssets / "testhair1/TestHair1.tfxproj");
+  const HeadFit tfit = fit_head(testhair);
+  EXPECT_TRUE(tfit.sphere);
+  EXPECT_FALSE(tfit.scalp);
+  EXPECT_NE(tfit.note.find("not a scalp"), std::string::npos) << tfit.note;
+  EXPECT_EQ(guess_unit(testhair, tfit, "testhair").unit, "cm");
+  // All the mohawk's roots, down the neck, fit a 53-unit sphere: a head in mm, but its
+  // 8-unit median strand is hair only in cm. The cues disagree: refused.
+  const Groom mohawk = tfx::read_tfx_strands(kMohawk);
+  const std::string why = error_of([&] { guess_unit(mohawk, fit_head(mohawk), "mohawk"); });
+  EXPECT_EQ(why.rfind("mohawk: unit: cannot tell the unit: no unit fits every cue [file units: head radius 52.86", 0),
+            0u)
+      << why;
+  EXPECT_NE(why.find("--unit"), std::string::npos) << why;
+  EXPECT_NE(why.find("--fit-above"), std::string::npos) << why;
 }
 
 // The mohawk in metres with strand 100's edge 5 made zero and strand 200's edge 7 1e-7 m
