@@ -31,9 +31,9 @@ ShardSpec parse_shard(const std::string& arg) {
 namespace {
 
 // The built-in cost table: median step time per vertex of each model at its default
-// parameters on the `shake` scenario (2,000 strands of 16 vertices), 2 threads on the
-// development machine (a 2-core x86-64 VM), and how the step grows with the
-// parameters that repeat its work, from sweeps of them there. A model missing here (a
+// parameters on the `shake` scenario (2,000 strands of 16 vertices, --no-skip, its first
+// 120 frames), 2 threads on the development machine (a 2-core x86-64 VM, idle), and how
+// the step grows with the parameters that repeat its work, from sweeps of them there. A model missing here (a
 // GPU model) is costed as its CPU method: the lockstep waits for it either way.
 struct TableEntry {
   std::string_view model;
@@ -48,25 +48,28 @@ struct TableEntry {
 };
 
 constexpr TableEntry kTable[] = {
-    {"han_m1", 20.0, true, "substeps", {{{"local_iterations", 0.55}, {"length_iterations", 0.08}}}},
-    {"han_m2", 31.0, true, "substeps", {{{"local_iterations", 0.69}, {"length_iterations", 0.05}}}},
-    {"han_m3", 12.0, true, "substeps", {{{"local_iterations", 0.10}, {"length_iterations", 0.14}}}},
-    {"han_m1_ref", 780.0, true, "substeps", {{{"local_iterations", 0.55}, {"length_iterations", 0.08}}}},
-    {"han_m2_ref", 550.0, true, "substeps", {{{"local_iterations", 0.69}, {"length_iterations", 0.05}}}},
-    {"han_m3_ref", 255.0, true, "substeps", {{{"local_iterations", 0.10}, {"length_iterations", 0.14}}}},
-    {"halen_spring", 23.0, true, "substeps", {{{"length_iterations", 0.13}, {"", 0.0}}}},
-    {"halen_cascade", 190.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"halen_forest", 50.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"halen_spring_ref", 310.0, true, "substeps", {{{"length_iterations", 0.13}, {"", 0.0}}}},
-    {"halen_cascade_ref", 820.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"halen_forest_ref", 930.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"plante_wisp", 270.0, false, "integration_hz", {{{"", 0.0}, {"", 0.0}}}},
-    {"plante_wisp_ref", 970.0, false, "integration_hz", {{{"", 0.0}, {"", 0.0}}}},
+    {"han_m1", 12.3, true, "substeps", {{{"local_iterations", 0.55}, {"length_iterations", 0.08}}}},
+    {"han_m2", 17.2, true, "substeps", {{{"local_iterations", 0.69}, {"length_iterations", 0.05}}}},
+    {"han_m3", 8.3, true, "substeps", {{{"local_iterations", 0.10}, {"length_iterations", 0.14}}}},
+    {"han_m1_ref", 247.0, true, "substeps", {{{"local_iterations", 0.55}, {"length_iterations", 0.08}}}},
+    {"han_m2_ref", 188.0, true, "substeps", {{{"local_iterations", 0.69}, {"length_iterations", 0.05}}}},
+    {"han_m3_ref", 102.0, true, "substeps", {{{"local_iterations", 0.10}, {"length_iterations", 0.14}}}},
+    {"halen_spring", 12.7, true, "substeps", {{{"length_iterations", 0.13}, {"", 0.0}}}},
+    {"halen_cascade", 69.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
+    {"halen_forest", 25.5, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
+    {"halen_spring_ref", 129.0, true, "substeps", {{{"length_iterations", 0.13}, {"", 0.0}}}},
+    {"halen_cascade_ref", 264.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
+    {"halen_forest_ref", 233.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
+    {"plante_wisp", 69.0, false, "integration_hz", {{{"", 0.0}, {"", 0.0}}}},
+    {"plante_wisp_ref", 251.0, false, "integration_hz", {{{"", 0.0}, {"", 0.0}}}},
 };
 
 // The lane's share of the lockstep that is not its step: the per-frame metrics
-// (deviation, jaggedness, length, rest shape, penetration), ns per vertex and frame.
-constexpr double kMetricsNsPerVertex = 20.0;
+// (deviation, jaggedness, length, rest shape, penetration, the verdicts' detectors), ns
+// of wall time per vertex and frame on the worker threads; measured as the unsharded
+// sweep's wall time less its steps and process over its vertex-frames (the idle/shake
+// sweep of docs/sharding.md: 1.9 s over 276 million).
+constexpr double kMetricsNsPerVertex = 7.0;
 // A frame in which every strand sleeps costs this share of a worked one (the sleep
 // bookkeeping).
 constexpr double kSleepShare = 0.05;
