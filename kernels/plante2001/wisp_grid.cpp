@@ -224,25 +224,34 @@ void masses_in(const SegmentGrid& g, const WispSystem& s, std::size_t i, std::si
   }
 }
 
+// Calls f(j) once for every segment j > i that shares a grid cell with segment i: the
+// mailbox (mailbox[j] == i once j has been seen from i) keeps a pair met in several cells
+// to one test (§4.1).
+template <class F>
+void for_each_later_candidate(const SegmentGrid& g, std::size_t i, std::vector<std::uint32_t>& mailbox, F&& f) {
+  for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
+    for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
+      for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
+        const std::size_t c = g.cell_at(x, y, z);
+        for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it) {
+          const std::uint32_t j = g.cell_items[it];
+          if (j <= i || mailbox[j] == i) continue;
+          mailbox[j] = static_cast<std::uint32_t>(i);
+          f(j);
+        }
+      }
+}
+
 }  // namespace
 
 void grid_contacts_ref(const SegmentGrid& g, const WispSystem& s, std::size_t begin, std::size_t end,
                        std::vector<std::uint32_t>& mailbox, std::vector<WispContact>& out) {
-  for (std::size_t i = begin; i < end; ++i) {
-    for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
-      for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::size_t c = g.cell_at(x, y, z);
-          for (std::uint32_t it = g.cell_start[c]; it < g.cell_start[c + 1]; ++it) {
-            const std::uint32_t j = g.cell_items[it];
-            if (j <= i || mailbox[j] == i) continue;
-            mailbox[j] = static_cast<std::uint32_t>(i);
-            if (neighbours(g, i, j) || !boxes_overlap(g, i, j)) continue;
-            masses_in(g, s, i, j, out);
-            masses_in(g, s, j, i, out);
-          }
-        }
-  }
+  for (std::size_t i = begin; i < end; ++i)
+    for_each_later_candidate(g, i, mailbox, [&](std::uint32_t j) {
+      if (neighbours(g, i, j) || !boxes_overlap(g, i, j)) return;
+      masses_in(g, s, i, j, out);
+      masses_in(g, s, j, i, out);
+    });
 }
 
 GridTestCounts grid_test_counts(const SegmentGrid& g, std::span<const WispContact> contacts) {
@@ -252,21 +261,13 @@ GridTestCounts grid_test_counts(const SegmentGrid& g, std::span<const WispContac
   std::vector<std::uint32_t> mailbox(n, ~0u);
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 1; j < n && neighbours(g, i, j); ++j) ++c.neighbour_pairs;
-    for (int z = g.cell_lo[i].z(); z <= g.cell_hi[i].z(); ++z)
-      for (int y = g.cell_lo[i].y(); y <= g.cell_hi[i].y(); ++y)
-        for (int x = g.cell_lo[i].x(); x <= g.cell_hi[i].x(); ++x) {
-          const std::size_t cell = g.cell_at(x, y, z);
-          for (std::uint32_t it = g.cell_start[cell]; it < g.cell_start[cell + 1]; ++it) {
-            const std::uint32_t j = g.cell_items[it];
-            if (j <= i || mailbox[j] == i) continue;
-            mailbox[j] = static_cast<std::uint32_t>(i);
-            if (neighbours(g, i, j)) continue;
-            ++c.box_tests;
-            if (!boxes_overlap(g, i, j)) continue;
-            ++c.box_overlaps;
-            c.volume_tests += kMassesPerSegment * (g.mass_free[i] + g.mass_free[j]);
-          }
-        }
+    for_each_later_candidate(g, i, mailbox, [&](std::uint32_t j) {
+      if (neighbours(g, i, j)) return;
+      ++c.box_tests;
+      if (!boxes_overlap(g, i, j)) return;
+      ++c.box_overlaps;
+      c.volume_tests += kMassesPerSegment * (g.mass_free[i] + g.mass_free[j]);
+    });
   }
   // A contact is a mass of node k, owned by segment (k - 1, k), inside segment c.seg's
   // volume; the segments ascend by first node (grid_segments).
