@@ -126,7 +126,8 @@ class HairModel {
   // pipeline compiled, the clock up) and leave their state as it was; nothing elsewhere.
   virtual void warm_up(const FrameInput& /*in*/, double /*seconds*/) {}
   // Models whose positions live on a device compute the per-frame metrics there
-  // (core/device_metrics.h); nullptr: the harness computes them from positions().
+  // (core/device_metrics.h), valid until the next reset(); nullptr: the harness computes
+  // them from positions().
   virtual DeviceMetrics* device_metrics() { return nullptr; }
 };
 
