@@ -6,8 +6,11 @@
 // (relative error at most u = 2^-24), division at most 2.5 ulp and sqrt that of
 // 1 / inversesqrt (4.5 ulp); an ulp is at most 2u of the value, so every device operation
 // errs by at most eps = 10u relatively, and a chain of k of them by at most
-// gamma(k) = k eps / (1 - k eps). The host works in double (rounding 2^-53) from the same
-// float positions. Per metric, with the host's exact-in-double values (d, l, kb, ...):
+// gamma(k) = k eps / (1 - k eps); a fused multiply-add, which Vulkan allows, rounds less.
+// Vulkan may flush subnormals to zero: no quantity here comes near 1e-38 (positions
+// differ by a float step of about 1e-8 m or more, or not at all). The host works in
+// double (rounding 2^-53) from the same float positions. Per metric, with the host's
+// exact-in-double values (d, l, kb, ...):
 //
 // - A per-vertex or per-edge term t computed with absolute error a (below), added up
 //   over a strand's n terms in float, errs by at most sum(a) + gamma(n) sum(|t| + a); the

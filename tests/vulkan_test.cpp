@@ -645,6 +645,29 @@ TEST(VulkanDeviceMetrics, RunnerStretched) {
   expect_same_runs(sc, opt, "han_m3");
 }
 
+// The blow-up test names the first vertex that is not finite, in strand order, as the
+// host's does (a NaN gravity makes every vertex but the pinned roots NaN).
+TEST(VulkanDeviceMetrics, NonFiniteNamesTheHostsVertex) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = test::builtin("shake", 16);
+  ThreadPool pool(1);
+  const ModelInfo* info = find_model("han_m3_vk");
+  const std::unique_ptr<HairModel> model = make_model(*info, sc, resolve_params(*info, sc, {}), pool);
+  const metrics::RestInfo rest(sc.groom);
+  DeviceMetrics* dm = model->device_metrics();
+  ASSERT_NE(dm, nullptr);
+  dm->prepare(metrics::device_rest(rest, sc.groom.positions));
+  StageTimes times;
+  FrameInput in = frame_input(sc, 0);
+  in.gravity.y() = std::numeric_limits<float>::quiet_NaN();
+  model->step(in, times);
+  const std::string host = metrics::blowup_reason(rest, model->positions(), in.head.translation());
+  ASSERT_EQ(host.rfind("non-finite position (strand 0, vertex ", 0), 0u) << host;
+  EXPECT_EQ(metrics::blowup_reason(dm->measure({in.head, in.head * in.head_prev.inverse(), in.gravity,
+                                                static_cast<float>(sc.dt), {}, model->positions()})),
+            host);
+}
+
 // The blow-up test names the first vertex beyond the distance, strand by strand, as the
 // host's does (here with a distance of 5 cm, which most of the hair is beyond).
 TEST(VulkanDeviceMetrics, BlowUpNamesTheHostsVertex) {
