@@ -16,6 +16,7 @@
 namespace hairbench {
 
 class ThreadPool;
+class DeviceMetrics;
 
 // Wall time per solver stage within one step, in the order the stages were first timed.
 // Fixed capacity and no allocation: it is filled inside the timed step.
@@ -124,6 +125,10 @@ class HairModel {
   // Before timing: GPU models run their step with `in` back to back for `seconds` (the
   // pipeline compiled, the clock up) and leave their state as it was; nothing elsewhere.
   virtual void warm_up(const FrameInput& /*in*/, double /*seconds*/) {}
+  // Models whose positions live on a device compute the per-frame metrics there
+  // (core/device_metrics.h), valid until the next reset(); nullptr: the harness computes
+  // them from positions().
+  virtual DeviceMetrics* device_metrics() { return nullptr; }
 };
 
 }  // namespace hairbench

@@ -7,6 +7,7 @@
 #include "harness/probe.h"
 #include "harness/roofline.h"
 #include "harness/shard.h"
+#include "reports/device_metrics.h"
 #include "reports/metrics.h"
 #include "reports/verdict.h"
 #include "scenarios/phases.h"
@@ -17,8 +18,9 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -220,12 +222,20 @@ struct Lane {
   RunRecord record;
   bool reported;
   bool running = true;
-  std::vector<Vec4f> prev;  // positions at the end of the previous frame
+  std::vector<Vec4f> prev;  // positions at the end of the previous frame (host metrics)
   metrics::EnergyGrowthCheck energy;
   verdict::StretchTracker stretch;
   verdict::SettleCheck settle;
   verdict::Probe probe;
   double kinetic = 0.0;  // this frame's kinetic energy relative to the head
+  // Metrics on the device (docs/metrics.md, Where the metrics are computed): the model's
+  // kernel, whether it reads the reference's positions on its device, this frame's
+  // per-strand values, and the frame whose positions it keeps for the most violent
+  // snapshot (-1: none).
+  DeviceMetrics* device = nullptr;
+  bool device_reference = false;
+  std::span<const StrandMetrics> strands{};
+  int kept_frame = -1;
 };
 
 // The lockstep run of one scenario, step by step: make the lanes (the reference first),
@@ -245,6 +255,7 @@ class LockstepRun {
 
  private:
   void make_lanes();
+  void use_device_metrics();
   void add_lane(const ModelInfo* info, const ParamSet& params, bool reported,
                 const std::vector<ParamOverride>& overrides);
   void step_lanes(const FrameInput& in, bool driven);
@@ -454,6 +465,24 @@ void LockstepRun::make_lanes() {
     }
     add_lane(info, params, true, concat(opt_.overrides, opt_.model_overrides));
   }
+  use_device_metrics();
+}
+
+// A model with a metrics kernel (the Vulkan models) is measured on its device unless
+// host metrics are asked for (RunOptions::host_metrics, HAIRBENCH_VK_HOST_METRICS=1). Its
+// kernel reads the reference's positions where the reference lives on the same device;
+// else they go up to it every frame (docs/vulkan.md, Data movement).
+void LockstepRun::use_device_metrics() {
+  const char* env = std::getenv("HAIRBENCH_VK_HOST_METRICS");
+  if (opt_.host_metrics || (env && *env && std::string_view(env) != "0")) return;
+  for (Lane& l : lanes_) {
+    l.device = l.model->device_metrics();
+    if (!l.device) continue;
+    l.device->prepare(metrics::device_rest(rest_, l.prev));
+    l.record.metrics_on = "device";
+  }
+  for (Lane& l : lanes_)
+    if (l.device && lanes_[0].device) l.device_reference = l.device->read_reference(*lanes_[0].device);
 }
 
 // Steps every running lane, timing the step. A frame counts as worked unless the model
@@ -484,10 +513,28 @@ void LockstepRun::step_lanes(const FrameInput& in, bool driven) {
 // check and the snapshots.
 void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
   std::vector<std::string> why(lanes_.size());
+  // The reference's positions, for the device lanes that cannot read them on their
+  // device: fetched here, once, before the lanes' tasks share them.
+  bool host_reference = false;
+  for (const Lane& l : lanes_) host_reference |= l.running && l.device && !l.device_reference;
+  const std::span<const Vec4f> reference =
+      host_reference && lanes_[0].running ? lanes_[0].model->positions() : std::span<const Vec4f>();
+  DeviceMetricsFrame frame{in.head, in.head * in.head_prev.inverse(), sc_.gravity, static_cast<float>(sc_.dt),
+                           spheres_, {}};
   pool_.parallel_for(lanes_.size(), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       Lane& l = lanes_[i];
       if (!l.running) continue;
+      if (l.device) {
+        DeviceMetricsFrame lane_frame = frame;
+        if (!l.device_reference) lane_frame.reference = reference;
+        l.strands = l.device->measure(lane_frame);
+        why[i] = metrics::blowup_reason(l.strands);
+        if (why[i].empty()) why[i] = l.energy.add(metrics::mechanical_energy(rest_, l.strands), driven);
+        l.kinetic = metrics::relative_kinetic_energy(rest_, l.strands, sc_.dt);
+        l.settle.add(in.t, l.kinetic, driven, sc_.settle_from);
+        continue;
+      }
       const auto p = l.model->positions();
       why[i] = metrics::blowup_reason(rest_, p, in.head.translation());
       if (why[i].empty()) why[i] = l.energy.add(metrics::mechanical_energy(p, l.prev, sc_.dt, sc_.gravity), driven);
@@ -512,22 +559,47 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
   }
 }
 
+namespace {
+// The per-frame values measure() records for each lane.
+enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFollowPenetration, kFrameMetrics };
+}  // namespace
+
 // The per-frame metrics cost as much as a fast model's step, so they run on the pool:
-// one task per lane and metric.
+// one task per lane and metric. A device lane's were computed by its kernel with the
+// divergence tests (stop_diverged); here its strands are added up.
 void LockstepRun::measure(const FrameInput& in) {
   const bool ref_ok = lanes_[0].running;
-  enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFollowPenetration, kFrameMetrics };
   std::vector<std::array<double, kFrameMetrics>> values(lanes_.size());
   std::vector<metrics::LengthError> length(lanes_.size()), guide_length(lanes_.size());
+  // The reference's positions for the host lanes, fetched once (a device reference reads
+  // them back here) before the tasks share them.
+  bool host_lanes = false;
+  for (const Lane& l : lanes_) host_lanes |= l.running && !l.device;
+  const std::span<const Vec4f> reference =
+      ref_ok && host_lanes ? lanes_[0].model->positions() : std::span<const Vec4f>();
+  const std::size_t guide_strands = guides_ ? guides_->groom->strand_count() : 0;
+  for (std::size_t i = 0; i < lanes_.size(); ++i) {
+    const Lane& l = lanes_[i];
+    if (!l.running || !l.device) continue;
+    const std::span<const StrandMetrics> m = l.strands;
+    auto& v = values[i];
+    v[kDeviation] = ref_ok ? metrics::deviation(rest_, m) : std::numeric_limits<double>::quiet_NaN();
+    v[kJaggedness] = metrics::jaggedness(rest_, m);
+    length[i] = metrics::length_error(rest_, m);
+    guide_length[i] = guides_ ? metrics::length_error(*guides_, m.first(guide_strands)) : length[i];
+    v[kRestShape] = metrics::rest_shape_error(rest_, m);
+    v[kPenetration] = metrics::penetration(guides_ ? m.first(guide_strands) : m);
+    v[kFollowPenetration] = guides_ ? metrics::penetration(m.subspan(guide_strands)) : 0.0;
+  }
   pool_.parallel_for(lanes_.size() * kFrameMetrics, [&](std::size_t b, std::size_t e) {
     for (std::size_t task = b; task < e; ++task) {
       const std::size_t i = task / kFrameMetrics;
-      if (!lanes_[i].running) continue;
+      if (!lanes_[i].running || lanes_[i].device) continue;
       const auto p = lanes_[i].model->positions();
       auto& v = values[i];
       switch (static_cast<FrameMetric>(task % kFrameMetrics)) {
         case kDeviation:
-          v[kDeviation] = ref_ok ? metrics::deviation(p, lanes_[0].model->positions(), rest_.mean_strand_length)
+          v[kDeviation] = ref_ok ? metrics::deviation(p, reference, rest_.mean_strand_length)
                                  : std::numeric_limits<double>::quiet_NaN();
           break;
         case kJaggedness: v[kJaggedness] = metrics::jaggedness(rest_, p); break;
@@ -578,8 +650,17 @@ void LockstepRun::snapshot(const FrameInput& in, int f, int frames) {
     max_violence_ = lanes_[0].kinetic;
     violent_frame_ = {"most_violent", f, in.t, max_violence_, in.head};
     for (Lane& l : lanes_) {
-      if (l.running) take_snapshot(sc_.groom, snap_strands_, l.model->positions(), l.record.snapshots[0], f);
-      else l.record.snapshots[0] = {"most_violent", -1, {}};
+      l.kept_frame = -1;
+      if (!l.running) {
+        l.record.snapshots[0] = {"most_violent", -1, {}};
+      } else if (l.device) {
+        // Kept on the device until the run ends: the most violent frame moves often
+        // while the motion builds up.
+        l.device->keep();
+        l.kept_frame = f;
+      } else {
+        take_snapshot(sc_.groom, snap_strands_, l.model->positions(), l.record.snapshots[0], f);
+      }
     }
   }
   if (f == frames - 1) {
@@ -676,6 +757,9 @@ std::vector<RunRecord> LockstepRun::run() {
     snapshot(in, f, frames);
     if (opt_.on_frame) opt_.on_frame(f + 1, frames);
   }
+  for (Lane& l : lanes_)
+    if (l.kept_frame >= 0)
+      take_snapshot(sc_.groom, snap_strands_, l.device->kept(), l.record.snapshots[0], l.kept_frame);
   if (opt_.scenario_record) record_scenario(frames);
   time_gpu_lanes();
 

@@ -79,6 +79,10 @@ struct RunOptions {
   // sleeps (ModelContext::skip_inert), to show what skipping saves and that it changes
   // nothing else.
   bool skip_inert = true;
+  // true: every model's metrics are computed on the host from its positions, as they are
+  // for the CPU models, also where a model could compute them on its device
+  // (HairModel::device_metrics); so does HAIRBENCH_VK_HOST_METRICS=1. Report runs[].metrics_on.
+  bool host_metrics = false;
 };
 
 // A model ready to step the scenario: made, given the follow hairs to rebuild from the

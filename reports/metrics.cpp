@@ -437,7 +437,7 @@ METRIC_CLONES double penetration(std::span<const Vec4f> p, std::span<const Vec4f
 // measures them (reports/verdict.h) and the run goes on.
 METRIC_CLONES std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center) {
   const Groom& g = *rest.groom;
-  const double far = rest.head_extent + 10.0 * rest.mean_strand_length;
+  const double far = blowup_distance(rest);
   const Eigen::Vector3d c = head_center.cast<double>();
   // A screen first, without branches so that it vectorises: squared distances against a
   // bound a little inside the test's (0.98 far^2 against far^2), where NaN and Inf fail
@@ -467,6 +467,8 @@ METRIC_CLONES std::string blowup_reason(const RestInfo& rest, std::span<const Ve
   }
   return {};
 }
+
+double blowup_distance(const RestInfo& rest) { return rest.head_extent + 10.0 * rest.mean_strand_length; }
 
 double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt, const Vec3f& gravity) {
   if (p.empty()) return 0.0;

@@ -95,6 +95,8 @@ double penetration(std::span<const Vec4f> p, std::span<const Vec4f> world_sphere
 // than 10 L-bar from the head (beyond the head's extent about `head_center`: see
 // metrics.cpp). Stretched edges are the `stretched` verdict's (reports/verdict.h).
 std::string blowup_reason(const RestInfo& rest, std::span<const Vec4f> p, const Vec3f& head_center);
+// The distance from the head centre beyond which a vertex has blown up (metrics.cpp).
+double blowup_distance(const RestInfo& rest);
 
 // Mean specific mechanical energy per vertex, in J/kg: kinetic ½|v|² with the frame's
 // velocity v = (p - prev) / dt, plus gravitational -g·p. The divergence check's energy growth test

@@ -315,6 +315,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   nlohmann::json out = {{"scenario", r.scenario},
                        {"model", r.model},
                        {"backend", r.backend},
+                       {"metrics_on", r.metrics_on},
                        {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
                        {"frames", r.frames},
                        {"frames_run", done},

@@ -23,6 +23,7 @@ struct RunRecord {
   std::string model;
   std::string backend = "cpu";
   std::string device;  // the GPU a GPU model ran on (run "device"; context "devices")
+  std::string metrics_on = "host";  // where the per-frame metrics were computed: "host" or "device"
   std::size_t strands = 0, vertices = 0;
   int frames = 0;  // frames requested
   double dt = 0.0;

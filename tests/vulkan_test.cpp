@@ -7,6 +7,7 @@
 // method x scenario agreements and the stability sweep are in vulkan_agreement_test.cpp
 // (label slow).
 #include "cli_support.h"
+#include "device_metrics_support.h"
 #include "harness/gpu_clock.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han2012/vulkan/model.h"
@@ -459,6 +460,235 @@ TEST(VulkanCli, ReportHasTheClockNvidiaSmiReads) {
   EXPECT_EQ(device["clock_mhz"], nlohmann::json({{"start", 1410.0}, {"end", 1410.0}, {"max", 1980.0}}));
   EXPECT_EQ(j["runs"][0]["timing"]["gpu_clock_mhz"], 1410.0);
   EXPECT_NE(r.out.find("at 1410 MHz"), std::string::npos) << r.out;
+}
+
+// Metrics on the device (kernels/vulkan/metrics.comp) equal reports/metrics.cpp's on the
+// same positions, read back, within the float rounding bound derived in
+// device_metrics_support.h (every device operation within eps = 10u, u = 2^-24, as
+// Vulkan's precision rules allow; per metric the terms' errors, the float sum per strand
+// and the double sum over strands): deviation against a CPU reference (uploaded),
+// jaggedness, length error (all strands and the guides), rest shape error, penetration
+// (guides and follow hairs apart), the blow-up test and the energies the verdicts read.
+void expect_within_bound(const test::MetricsAgreement& a, const std::string& what) {
+  a.print(what);
+  EXPECT_TRUE(a.resolved) << what << ": a curvature binormal too close to a hairpin for the bound";
+  for (const auto& [name, ratio] : a.worst_ratio) EXPECT_LE(ratio, 1.0) << what << ": " << name;
+}
+
+// A sphere about the head centre 2 cm larger than the head, in the metrics only: the roots
+// and the vertices near them are inside it, so penetration is centimetres, not rounding.
+Vec4f inflated_head(const Scenario& sc, const FrameInput& in) {
+  const Vec3f c = in.head.translation();
+  return {c.x(), c.y(), c.z(), sc.groom.head_radius + 0.02f};
+}
+
+// The TressFX ponytail shake, its follow hairs built on the device: the guides' and the
+// follow hairs' length error and penetration apart.
+TEST(VulkanDeviceMetrics, PonytailShakeWithFollowHairs) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = thin_ponytail();
+  const test::MetricsAgreement a =
+      test::device_vs_host_metrics(sc, "han_m3_vk", "han_m3", 24, {inflated_head(sc, frame_input(sc, 0))});
+  expect_within_bound(a, "ponytail shake");
+  EXPECT_GT(a.largest.at("penetration_guides"), 0.005);
+  EXPECT_GT(a.largest.at("penetration_follow"), 0.005);
+  EXPECT_GT(a.largest.at("rest_shape_error"), 1e-3) << "the shake should move the hair";
+}
+
+// Han & Harada's Table 1 model 1 (thinned), its three colliders, under its rotation.
+TEST(VulkanDeviceMetrics, Han2012Model1) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_TEST_DATA_DIR) / "../../scenarios/paper/han2012_model1.json");
+  sc.groom = every_nth_strand(sc.groom, 32);
+  const test::MetricsAgreement a = test::device_vs_host_metrics(sc, "han_m1_vk", "han_m1", 12);
+  expect_within_bound(a, "han2012 model 1");
+  EXPECT_GT(a.largest.at("deviation"), 0.0);
+}
+
+// Penetration well above rounding: the shake with a sphere through the hair near the
+// roots (metrics only; the models collide with the scenario's colliders).
+TEST(VulkanDeviceMetrics, Penetration) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = test::builtin("shake", 16);
+  const test::MetricsAgreement a =
+      test::device_vs_host_metrics(sc, "han_m2_vk", "han_m1", 12, {inflated_head(sc, frame_input(sc, 0))});
+  expect_within_bound(a, "shake, a sphere through the hair");
+  EXPECT_GT(a.largest.at("penetration"), 0.01);
+}
+
+// A jagged case: the fast spin's abrupt start kinks the strands (jaggedness about 0.3).
+TEST(VulkanDeviceMetrics, Jagged) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const test::MetricsAgreement a = test::device_vs_host_metrics(test::builtin("spin_fast", 16), "han_m3_vk", "han_m1", 30);
+  expect_within_bound(a, "spin_fast");
+  EXPECT_GT(a.largest.at("jaggedness"), 0.1);
+}
+
+// Rest edges of 2.4e-7 m, as exporters write them, on every fourth strand: the jaggedness
+// pairs across them weigh 0 (docs/metrics.md, jaggedness), on the device too.
+TEST(VulkanDeviceMetrics, DegenerateEdges) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  Scenario sc = test::builtin("shake", 16);
+  for (std::size_t s = 0; s < sc.groom.strand_count(); s += 4) {
+    const std::size_t b = sc.groom.strand_begin(s);
+    sc.groom.positions[b + 5].head<3>() = sc.groom.positions[b + 4].head<3>() + Vec3f(2.4e-7f, 0.0f, 0.0f);
+  }
+  const metrics::RestInfo rest(sc.groom);
+  ASSERT_NE(std::count(rest.kb_weight.begin(), rest.kb_weight.end(), 0.0), 0);
+  const test::MetricsAgreement a = test::device_vs_host_metrics(sc, "han_m2_vk", "han_m2", 20);
+  expect_within_bound(a, "rounding-sized rest edges");
+}
+
+// Through the runner: a lockstep run with the Vulkan lanes' metrics on the device and
+// the same run with them on the host (RunOptions::host_metrics, as
+// HAIRBENCH_VK_HOST_METRICS=1) give the same verdicts, snapshots and state hashes, and
+// every frame's metrics within the bound above. The bound comes from
+// device_vs_host_metrics on the same models stepped alike (the host run's metrics equal
+// its host values bit for bit, so the positions are the same).
+void expect_same_runs(const Scenario& sc, RunOptions opt, const std::string& reference_name) {
+  ThreadPool pool(2);
+  opt.reference = reference_name;
+  opt.probe = false;  // the probe's verdict does not depend on where the metrics are computed
+  opt.host_metrics = false;
+  const std::vector<RunRecord> device = run_scenario(sc, opt, pool);
+  opt.host_metrics = true;
+  const std::vector<RunRecord> host = run_scenario(sc, opt, pool);
+  ASSERT_EQ(device.size(), host.size());
+  for (std::size_t r = 0; r < device.size(); ++r) {
+    const RunRecord &d = device[r], &h = host[r];
+    const bool on_device = d.backend == "vulkan";
+    SCOPED_TRACE(d.model);
+    EXPECT_EQ(d.metrics_on, on_device ? "device" : "host");
+    EXPECT_EQ(h.metrics_on, "host");
+    EXPECT_EQ(verdict::status_name(d.verdict.status), verdict::status_name(h.verdict.status));
+    EXPECT_EQ(d.failure.has_value(), h.failure.has_value());
+    EXPECT_EQ(d.verdict.stretch.peak_frame, h.verdict.stretch.peak_frame);
+    EXPECT_EQ(d.verdict.stretch.worst_strand, h.verdict.stretch.worst_strand);
+    EXPECT_EQ(d.verdict.stretch.worst_edge, h.verdict.stretch.worst_edge);
+    EXPECT_EQ(d.verdict.stretch.frames_above, h.verdict.stretch.frames_above);
+    EXPECT_EQ(d.verdict.settle.frames, h.verdict.settle.frames);
+    EXPECT_EQ(d.verdict.settle.decays, h.verdict.settle.decays);
+    EXPECT_EQ(d.state_hash, h.state_hash);
+    ASSERT_EQ(d.snapshots.size(), h.snapshots.size());
+    for (std::size_t k = 0; k < d.snapshots.size(); ++k) {
+      EXPECT_EQ(d.snapshots[k].frame, h.snapshots[k].frame) << d.snapshots[k].label;
+      EXPECT_EQ(d.snapshots[k].strands, h.snapshots[k].strands) << d.snapshots[k].label;
+    }
+    ASSERT_EQ(d.t.size(), h.t.size());
+    if (!on_device) {
+      // A host lane beside device lanes: the same numbers (its reference read back).
+      EXPECT_EQ(d.deviation, h.deviation);
+      EXPECT_EQ(d.jaggedness, h.jaggedness);
+      EXPECT_EQ(d.length_max, h.length_max);
+      continue;
+    }
+    const test::MetricsAgreement a =
+        test::device_vs_host_metrics(sc, d.model, reference_name, static_cast<int>(d.t.size()), {}, opt.overrides);
+    double worst = 0.0;
+    for (std::size_t f = 0; f < d.t.size(); ++f) {
+      const test::FrameMetrics& b = a.frames[f];
+      const auto check = [&](const char* name, double dv, double hv, const test::MetricPair& bound) {
+        ASSERT_EQ(hv, bound.host) << name << ", frame " << f << ": the host run's positions are not the check's";
+        EXPECT_LE(std::abs(dv - hv), bound.bound) << name << ", frame " << f;
+        if (bound.bound > 0.0) worst = std::max(worst, std::abs(dv - hv) / bound.bound);
+      };
+      check("deviation", d.deviation[f], h.deviation[f], b.at("deviation"));
+      check("jaggedness", d.jaggedness[f], h.jaggedness[f], b.at("jaggedness"));
+      check("length_error rms", d.length_rms[f], h.length_rms[f], b.at("length_rms"));
+      check("length_error max", d.length_max[f], h.length_max[f], b.at("length_max"));
+      check("rest_shape_error", d.rest_shape_error[f], h.rest_shape_error[f], b.at("rest_shape_error"));
+      if (sc.follow) {
+        check("penetration guides", d.penetration_guides[f], h.penetration_guides[f], b.at("penetration_guides"));
+        check("penetration follow", d.penetration_follow[f], h.penetration_follow[f], b.at("penetration_follow"));
+      } else {
+        check("penetration", d.penetration[f], h.penetration[f], b.at("penetration"));
+      }
+    }
+    std::printf("%s: runner's device metrics within %.3g of the bound of the host's\n", d.model.c_str(), worst);
+  }
+}
+
+// A CPU reference: its positions go up to the device lane every frame.
+TEST(VulkanDeviceMetrics, RunnerPonytailHostReference) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  RunOptions opt;
+  opt.models = {"han_m3_vk"};
+  opt.frames = 30;
+  expect_same_runs(thin_ponytail(), opt, "han_m3");
+}
+
+// A Vulkan reference: the device lanes read its positions on the device (the reference's
+// own deviation is 0 on both paths), and a CPU lane beside them reads them back.
+TEST(VulkanDeviceMetrics, RunnerModel1DeviceReference) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  Scenario sc = load_scenario(std::filesystem::path(HAIRBENCH_TEST_DATA_DIR) / "../../scenarios/paper/han2012_model1.json");
+  sc.groom = every_nth_strand(sc.groom, 32);
+  RunOptions opt;
+  opt.models = {"han_m1_vk", "han_m2_vk", "han_m3"};
+  opt.frames = 12;
+  expect_same_runs(sc, opt, "han_m1_vk");
+}
+
+// A stretched run (no shape or length constraints, no damping, in the fast spin): the
+// stretched verdict's peak frame and worst edge are the same from the device's metrics.
+TEST(VulkanDeviceMetrics, RunnerStretched) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  RunOptions opt;
+  opt.models = {"han_m3_vk"};
+  opt.frames = 40;
+  opt.overrides = {{"*", "local_iterations", 0}, {"*", "length_iterations", 0}, {"*", "damping", 0}};
+  ThreadPool pool(1);
+  opt.reference = "han_m3";
+  opt.probe = false;
+  const Scenario sc = test::builtin("spin_fast", 8);
+  EXPECT_EQ(run_scenario(sc, opt, pool)[0].verdict.status, verdict::Status::stretched);
+  expect_same_runs(sc, opt, "han_m3");
+}
+
+// The blow-up test names the first vertex that is not finite, in strand order, as the
+// host's does (a NaN gravity makes every vertex but the pinned roots NaN).
+TEST(VulkanDeviceMetrics, NonFiniteNamesTheHostsVertex) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = test::builtin("shake", 16);
+  ThreadPool pool(1);
+  const ModelInfo* info = find_model("han_m3_vk");
+  const std::unique_ptr<HairModel> model = make_model(*info, sc, resolve_params(*info, sc, {}), pool);
+  const metrics::RestInfo rest(sc.groom);
+  DeviceMetrics* dm = model->device_metrics();
+  ASSERT_NE(dm, nullptr);
+  dm->prepare(metrics::device_rest(rest, sc.groom.positions));
+  StageTimes times;
+  FrameInput in = frame_input(sc, 0);
+  in.gravity.y() = std::numeric_limits<float>::quiet_NaN();
+  model->step(in, times);
+  const std::string host = metrics::blowup_reason(rest, model->positions(), in.head.translation());
+  ASSERT_EQ(host.rfind("non-finite position (strand 0, vertex ", 0), 0u) << host;
+  EXPECT_EQ(metrics::blowup_reason(dm->measure({in.head, in.head * in.head_prev.inverse(), in.gravity,
+                                                static_cast<float>(sc.dt), {}, model->positions()})),
+            host);
+}
+
+// The blow-up test names the first vertex beyond the distance, strand by strand, as the
+// host's does (here with a distance of 5 cm, which most of the hair is beyond).
+TEST(VulkanDeviceMetrics, BlowUpNamesTheHostsVertex) {
+  HAIRBENCH_REQUIRE_VULKAN();
+  const Scenario sc = test::builtin("shake", 16);
+  ThreadPool pool(1);
+  const ModelInfo* info = find_model("han_m3_vk");
+  const std::unique_ptr<HairModel> model = make_model(*info, sc, resolve_params(*info, sc, {}), pool);
+  metrics::RestInfo rest(sc.groom);
+  rest.head_extent = 0.05 - 10.0 * rest.mean_strand_length;
+  DeviceMetrics* dm = model->device_metrics();
+  ASSERT_NE(dm, nullptr);
+  dm->prepare(metrics::device_rest(rest, sc.groom.positions));
+  StageTimes times;
+  const FrameInput in = frame_input(sc, 0);
+  model->step(in, times);
+  const std::string host = metrics::blowup_reason(rest, model->positions(), in.head.translation());
+  ASSERT_FALSE(host.empty());
+  EXPECT_EQ(metrics::blowup_reason(dm->measure({in.head, in.head * in.head_prev.inverse(), sc.gravity,
+                                                static_cast<float>(sc.dt), {}, model->positions()})),
+            host);
 }
 
 // nvidia-smi's lines are "NAME, SM CLOCK, MAX SM CLOCK" (names may hold commas); a clock it

@@ -1,4 +1,5 @@
-// The SPIR-V of the compute shaders in this folder, compiled by glslc at build time.
+// The SPIR-V of the compute shaders (kernels/vulkan/CMakeLists.txt), compiled by glslc
+// at build time.
 #pragma once
 
 #include <cstdint>
@@ -10,5 +11,7 @@ namespace hairbench::vk {
 std::span<const std::uint32_t> han_step_spirv();
 // follow_hairs.comp: TressFX follow hairs from the guides' device positions.
 std::span<const std::uint32_t> follow_hairs_spirv();
+// metrics.comp: the harness's per-frame metrics per strand (kernels/vulkan/metrics.h).
+std::span<const std::uint32_t> metrics_spirv();
 
 }  // namespace hairbench::vk

@@ -200,6 +200,7 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   substeps_ = params.get_int("substeps");
 
   // The kernels and the readback hold buffers by handle: drop them before the buffers.
+  metrics_.reset();
   commands_.reset();
   kernel_.reset();
   follow_kernel_.reset();
@@ -241,6 +242,7 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   commands_ = ctx.commands();
   commands_->record(dispatches);
   readback_ = ctx.readback(pos_);
+  metrics_ = std::make_unique<vk::MetricsKernel>(context_, pos_, rest.vertex_count());
 
   host_pos_ = rest.positions;
   host_current_ = true;

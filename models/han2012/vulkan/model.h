@@ -9,6 +9,7 @@
 
 #include "core/hair_model.h"
 #include "kernels/han2012/vulkan/han_layout.h"
+#include "kernels/vulkan/metrics.h"
 #include "kernels/vulkan/runtime.h"
 #include "models/han2012/reference/model.h"
 
@@ -52,6 +53,8 @@ class HanVkModel final : public HairModel {
   std::span<const Vec4f> positions() const override;
   Backend backend() const override { return {"vulkan", context_->device().name}; }
   std::optional<double> last_gpu_ms() const override { return gpu_ms_; }
+  // The harness's metrics on the device, over the whole groom (the follow hairs too).
+  DeviceMetrics* device_metrics() override { return metrics_.get(); }
   // Device time of the last step's follow hairs dispatch; nullopt without follow hairs.
   std::optional<double> last_follow_gpu_ms() const { return follow_gpu_ms_; }
 
@@ -66,6 +69,7 @@ class HanVkModel final : public HairModel {
   std::unique_ptr<vk::Kernel> kernel_, follow_kernel_;
   std::unique_ptr<vk::Commands> commands_;
   std::unique_ptr<vk::Readback> readback_;  // pos_ to host_pos_
+  std::unique_ptr<vk::MetricsKernel> metrics_;  // reads pos_
   vk::Buffer pos_, prev_, rot_, rest_, rest_local_, rest_rot_, strands_, regions_, frame_, spheres_;
   vk::Buffer follow_strands_, follow_vertices_;
   // The follow hairs in the device's layout (han_layout.h), and the guides' strand
