@@ -290,7 +290,7 @@ TEST(HalenForest, FirstJointSubtractsTheHeadsAngularAcceleration) {
 }
 
 // The thesis as written (settings.h): no gravity compensation, J ≈ mI, the head's
-// angular acceleration subtracted at the first joint. It runs stably on the scenarios
+// angular acceleration subtracted at the first joint, no drag, an undamped penalty. It runs stably on the scenarios
 // docs/limitations.md reports, and J ≈ mI leaves gravity a small fraction of the joint
 // springs: at rest the hair sags, by less than 1e-3 L-bar. Known difference: the sphere
 // penalty forces, scaled down with gravity, let `shake` push the hair deeper into the head
@@ -298,7 +298,9 @@ TEST(HalenForest, FirstJointSubtractsTheHeadsAngularAcceleration) {
 TEST(HalenForest, ThesisAsWrittenIsStiffAndStable) {
   const std::vector<ParamOverride> thesis = {{"halen_forest", "gravity_compensation", 0},
                                              {"halen_forest", "inertia", 0},
-                                             {"halen_forest", "root_angular_acceleration", 1}};
+                                             {"halen_forest", "root_angular_acceleration", 1},
+                                             {"halen_forest", "drag", 0},
+                                             {"halen_forest", "collision_damping", 0}};
   for (const char* name : {"idle", "shake", "tilt_upside_down", "spin_fast"}) {
     const auto runs = test::run(builtin(name, 16), {"halen_forest"}, thesis);
     const RunRecord& r = test::find(runs, "halen_forest");
@@ -313,6 +315,99 @@ TEST(HalenForest, ThesisAsWrittenIsStiffAndStable) {
       EXPECT_GT(test::max_of(r.penetration), test::max_of(test::find(defaults, "halen_forest").penetration));
     }
   }
+}
+
+// Straight strands of `vertices` vertices and `length` metres standing up from the crown
+// of the `idle` head (roots within 35° of the top, radial), as a mohawk's do.
+Scenario upright_scenario(int vertices, double length) {
+  Scenario sc = builtin("idle", 1);
+  Groom g;
+  const float r = sc.head_radius;
+  for (int a = 0; a < 8; ++a)
+    for (int b = 1; b <= 4; ++b) {
+      const float tilt = 0.6f * static_cast<float>(b) / 4.0f, turn = 0.785f * static_cast<float>(a);
+      const Vec3f dir(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
+      std::vector<Vec3f> pts;
+      for (int i = 0; i < vertices; ++i)
+        pts.push_back(dir * (r + static_cast<float>(length) * static_cast<float>(i) / static_cast<float>(vertices - 1)));
+      g.add_strand(pts, 0);
+    }
+  sc.groom = g;
+  return sc;
+}
+
+// kernels::forest_rest_inertia_scale on one straight strand of m free segments with equal
+// joints k (no falloff): K is the fixed-free chain, whose smallest eigenvalue is
+// 4k sin²(π / (2(2m + 1))), and gravity turns each upright segment at g/ℓ per radian, so
+// J must rise by margin · (g/ℓ) / that eigenvalue; a hanging or level strand, or no
+// gravity, needs nothing.
+TEST(HalenKernels, RestInertiaScaleIsTheChainsBucklingBound) {
+  const int n = 32;  // 2 pinned + 30 free segments after the root edge
+  const double length = 0.08, k = 5000.0, g = 9.81, margin = kernels::kForestRestMargin;
+  auto scale = [&](const Vec3f& dir, const Vec3f& gravity) {
+    std::vector<Vec4f> rest;
+    for (int i = 0; i < n; ++i) {
+      const Vec3f p = dir * static_cast<float>(length * i / (n - 1));
+      rest.emplace_back(p.x(), p.y(), p.z(), i < 2 ? 0.0f : 1.0f);
+    }
+    std::vector<kernels::Mat3f> frame(n);
+    std::vector<float> theta0(n), phi0(n), len(n), stiffness(n);
+    const float inv_length = kernels::forest_setup(rest, kernels::ForestAxes::ParentX, static_cast<float>(k), 0.0f, 2,
+                                                   frame, theta0, phi0, len, stiffness);
+    return kernels::forest_rest_inertia_scale(rest, len, stiffness, inv_length, gravity, margin);
+  };
+  const int m = n - 2;
+  const double lambda = 4.0 * k * std::pow(std::sin(M_PI / (2.0 * (2 * m + 1))), 2);
+  const double expected = margin * (g / length) / lambda;
+  const Vec3f down(0.0f, -static_cast<float>(g), 0.0f);
+  EXPECT_NEAR(scale(Vec3f::UnitY(), down), expected, 1e-4 * expected);
+  EXPECT_GT(expected, 10.0) << "a 30-segment 8 cm strand at the default k must need it";
+  EXPECT_EQ(scale(-Vec3f::UnitY(), down), 1.0f);
+  EXPECT_EQ(scale(Vec3f::UnitX(), down), 1.0f);
+  EXPECT_EQ(scale(Vec3f::UnitY(), Vec3f::Zero()), 1.0f);
+}
+
+// With J = m L ℓ gravity's pull on an upright segment does not fall with the segment
+// count while the joints' slowest mode does: the rest state of 8 cm, 32-vertex strands
+// standing on the crown grows under the probe's kick when every strand keeps J
+// (rest_hold 0), and is stable with J raised where it topples (the default).
+TEST(HalenForest, RestHoldKeepsUprightStrandsStanding) {
+  const Scenario sc = upright_scenario(32, 0.08);
+  ThreadPool pool(2);
+  const ModelInfo* info = find_model("halen_forest");
+  auto probe = [&](double hold) {
+    const verdict::Probe p = perturbation_probe(*info, sc, resolve_params(*info, sc, {{"halen_forest", "rest_hold", hold}}), pool);
+    RecordProperty("rate_rest_hold" + std::to_string(int(hold)), std::to_string(p.rate));
+    EXPECT_TRUE(p.run);
+    return p;
+  };
+  EXPECT_TRUE(probe(0).grows);
+  EXPECT_FALSE(probe(1).grows);
+}
+
+// A strand of many segments keeps swinging after the head stops unless something damps
+// its slowest mode: Eq. 4.2.2's joint damping v reaches it as v (π / 2n)² (0.3/s at 32
+// vertices), and a toppled upright strand circles, pumped by any torque that is not the
+// gradient of an energy. With drag, the damped penalty and gravity compensation as a force,
+// the upright groom of RestHoldKeepsUprightStrandsStanding at 64 vertices comes to rest
+// after `nod` (the settle check's energy falls), and faster with the drag than without.
+TEST(HalenForest, FineUprightStrandsSettleAfterTheHeadStops) {
+  Scenario sc = upright_scenario(64, 0.08);
+  const Scenario nod = builtin("nod", 1);
+  sc.head = nod.head;
+  sc.frames = nod.frames;
+  sc.settle_from = nod.settle_from;
+  auto settle = [&](double drag) {
+    const auto runs = test::run(sc, {"halen_forest"}, {{"halen_forest", "drag", drag}});
+    const RunRecord& r = test::find(runs, "halen_forest");
+    RecordProperty("settle_rate_drag" + std::to_string(int(drag)), std::to_string(r.verdict.settle.rate));
+    EXPECT_FALSE(r.failure);
+    return r;
+  };
+  const RunRecord with_drag = settle(2.0), without = settle(0.0);
+  EXPECT_EQ(with_drag.verdict.status, verdict::Status::ok) << with_drag.verdict.reason;
+  EXPECT_TRUE(with_drag.verdict.settle.decays);
+  EXPECT_LT(with_drag.verdict.settle.rate, without.verdict.settle.rate);
 }
 
 // The perturbation probe (harness/probe.h) of the cascade on the `idle` groom with

@@ -68,7 +68,8 @@ const Config& cascade_thesis() {
 const Config& forest_thesis() {
   static const Config c =
       config("forest", "halen_forest",
-             {{"axis_convention", 1}, {"gravity_compensation", 0}, {"inertia", 0}, {"root_angular_acceleration", 1}});
+             {{"axis_convention", 1}, {"gravity_compensation", 0}, {"inertia", 0}, {"root_angular_acceleration", 1},
+              {"drag", 0}, {"collision_damping", 0}});
   return c;
 }
 // halen_cascade's defaults: each reference spring pushes back on the segment that carries
@@ -559,13 +560,15 @@ PaperResult reproduce_halen(const Ctx& c) {
                          "One way to ease these problems is to change the model defined in [DCF01] to use the x-axis "
                          "of the parent instead of the z-axis as the primary rotation axis."},
                         "J ≈ mI (Eq. 4.2.4); gravity uncompensated; Ω̇_p of the first joint = the head's (Eq. 4.2.5); "
-                        "θ about the parent's x axis",
+                        "θ about the parent's x axis; no drag (Eq. 4.2.2's joint damping only); an undamped sphere penalty",
                         "halen_forest inertia=" + num(fp.get("inertia")) +
                             " gravity_compensation=" + num(fp.get("gravity_compensation")) +
                             " root_angular_acceleration=" + num(fp.get("root_angular_acceleration")) +
-                            " axis_convention=" + num(fp.get("axis_convention")),
+                            " axis_convention=" + num(fp.get("axis_convention")) + " drag=" + num(fp.get("drag")) +
+                            " collision_damping=" + num(fp.get("collision_damping")),
                         fp.get("inertia") == 0.0 && fp.get("gravity_compensation") == 0.0 &&
-                            fp.get("root_angular_acceleration") == 1.0 && fp.get("axis_convention") == 1.0,
+                            fp.get("root_angular_acceleration") == 1.0 && fp.get("axis_convention") == 1.0 &&
+                            fp.get("drag") == 0.0 && fp.get("collision_damping") == 0.0,
                         "the y-force claim also runs axis_convention=0, Di Giacomo et al.'s z axis"});
     const double a = ps["stiffness_falloff_exponent"];
     r.setups.push_back(

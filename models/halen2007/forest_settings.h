@@ -10,18 +10,32 @@
 // explicit Euler step of Eq. 4.2.6 (v ≥ 4k dt, and 4 v dt < 2): twelve substeps with
 // v = 120 s^-1.
 //
-// Three defaults are not §4.2's; each is a parameter, and
+// Five defaults are not §4.2's; each is a parameter, and
 //   --set halen_forest.gravity_compensation=0 --set halen_forest.inertia=0
-//   --set halen_forest.root_angular_acceleration=1
-// selects the thesis as written (docs/limitations.md gives what it does). Gravity
-// compensation keeps the head-transformed rest pose in equilibrium, as the other two
-// models' L = mg/k does. J = m L ℓ scales the external torques to the strand: under §4.2's
-// J ≈ mI a 1.7 cm segment gets at most L g = 0.16 rad/s² from gravity, against joint
-// springs of thousands of s^-2 per radian (above), so gravity, the root's inertial force
-// and the sphere penalty forces hardly bend the hair. The head's rotation reaches the
-// joints through the inertial force of the moving root, which holds it at every segment
-// end; Eq. 4.2.5's Ω̇_p = Ω̇_H for the first joint on top of that counts the head's angular
-// acceleration twice (on `shake` the hair then never settles).
+//   --set halen_forest.root_angular_acceleration=1 --set halen_forest.drag=0
+//   --set halen_forest.collision_damping=0
+// selects the thesis as written (docs/limitations.md gives what it does; rest_hold acts
+// only with inertia 1). Gravity compensation keeps the head-transformed rest pose in
+// equilibrium, as the other two models' L = mg/k does; it takes the part of gravity normal
+// to each rest segment off as a force, not as a constant torque, which in 3D would do net
+// work on a segment that circles. J = m L ℓ scales the external torques to the strand:
+// under §4.2's J ≈ mI a 1.7 cm segment gets at most L g = 0.16 rad/s² from gravity,
+// against joint springs of thousands of s^-2 per radian (above), so gravity, the root's
+// inertial force and the sphere penalty forces hardly bend the hair. The head's rotation
+// reaches the joints through the inertial force of the moving root, which holds it at
+// every segment end; Eq. 4.2.5's Ω̇_p = Ω̇_H for the first joint on top of that counts the
+// head's angular acceleration twice (on `shake` the hair then never settles).
+//
+// The joint damping v reaches a strand's slowest swing as v (π / 2n)², 0.3 s^-1 at 32
+// vertices, so finer strands swing on for many seconds: `drag` damps each segment's
+// rotation relative to the head directly, at any segment count. A penalty force on a
+// segment's end turns that segment alone while its parents move the end, a coupling that
+// is not the gradient of an energy, and an undamped penalty returns all it stores:
+// `collision_damping` damps the penalty along the sphere's normal. With J = m L ℓ gravity
+// turns every segment at g/ℓ per radian of tilt, whatever the segment count, while the
+// joints' slowest mode falls as k/n²: an upright strand (a mohawk, a groom resampled to
+// 64 vertices) held in its rest pose by gravity compensation topples out of it.
+// `rest_hold` raises such a strand's J, strand by strand, until its joints hold it.
 #pragma once
 
 #include "core/params.h"
@@ -30,7 +44,7 @@
 
 namespace hairbench::halen_forest {
 
-inline constexpr std::array<ParamSpec, 10> kParams{{
+inline constexpr std::array<ParamSpec, 13> kParams{{
     {"joint_stiffness", 5000.0, 0.0, 1e6, false,
      "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2"},
     {"joint_damping", 120.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},
@@ -42,6 +56,9 @@ inline constexpr std::array<ParamSpec, 10> kParams{{
      "(Di Giacomo et al.'s original, stiff near straight strands)"},
     {"collision_stiffness", 0.3, 0.0, 1.0, false,
      "sphere penalty force: the fraction of the penetration depth it would remove in one substep"},
+    {"collision_damping", 1.0, 0.0, 1.5, false,
+     "ζ: the penalty force is damped along the sphere's normal at ζ times critical for it, 2ζ √(collision_stiffness) / dt; "
+     "held within that rate times depth / dt; 0 a spring only"},
     {"substeps", 12, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
     {"gravity_compensation", 1, 0, 1, true,
      "1: gravity's torque on the head-transformed rest segment is subtracted, so that pose is in "
@@ -52,6 +69,14 @@ inline constexpr std::array<ParamSpec, 10> kParams{{
     {"root_angular_acceleration", 0, 0, 1, true,
      "1: the head's angular acceleration is the first joint's Ω̇_p in Eq. 4.2.5 (§4.2 as written); 0: the "
      "head's rotation acts only through the inertial force of the moving root"},
+    {"drag", 2.0, 0.0, 1e3, false,
+     "d, s^-1: each segment's rotation relative to the head decays at d (every joint's rates kept "
+     "exp(-d dt) a step); not in §4.2, whose joint damping v reaches a strand's slowest swing as "
+     "v (π / 2n)² only"},
+    {"rest_hold", 1, 0, 1, true,
+     "with inertia 1: 1 a strand whose rest pose gravity would topple (upright segments) gets J = m L ℓ "
+     "raised until its joints hold it under twice its weight (kernels::forest_rest_inertia_scale); 0 J as "
+     "given on every strand"},
 }};
 
 }  // namespace hairbench::halen_forest

@@ -6,6 +6,7 @@
 #include "kernels/simd/soa_rows.h"
 #include "kernels/simd/vec_math.h"
 
+#include <algorithm>
 #include <cmath>
 
 #ifndef HAIRBENCH_ISA_VARIANT
@@ -112,7 +113,9 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
   const int n = r.n;
   const int prim = f.parent_x ? 0 : 2;  // the parent's primary axis: column 0 (x) or 2 (z)
   const float v = p.joint_damping, dt = f.dt;
+  const float keep = std::exp(-p.drag * dt);
   const float push = p.collision_stiffness / (dt * dt);
+  const float damp = 2.0f * p.collision_damping * std::sqrt(p.collision_stiffness) / dt;
   const float gx = f.gravity[0], gy = f.gravity[1], gz = f.gravity[2];
   const float wx = f.wind[0], wy = f.wind[1], wz = f.wind[2];
   const float* in = h.inertia;
@@ -144,8 +147,14 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
   // What turns a torque per unit mass into an angular acceleration (ForestInertia): 1/ℓ
   // (one row after the fields) or the segment's length.
   const float* inv_len = r.c + static_cast<std::size_t>(kForestFields) * fs;
+  // The segment's angular velocity and its end's velocity relative to the head, summed
+  // from the root; a pinned segment is rigid with the head.
+  alignas(64) float spx[W] = {}, spy[W] = {}, spz[W] = {}, ux[W] = {}, uy[W] = {}, uz[W] = {};
   for (int i = 1; i < n; ++i) {
-    if (r.kind[i] == kRowPinned) continue;
+    if (r.kind[i] == kRowPinned) {
+      for (float* q : {spx, spy, spz, ux, uy, uz}) std::fill_n(q, W, 0.0f);
+      continue;
+    }
     const int o = i * W;
     const float *iw = r.field(FIW, i), *gain = f.mass_inertia ? r.field(FLEN, i) : inv_len;
     const float* R2 = r.field(FR6, i);  // rest frame's z column
@@ -155,8 +164,22 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
                 *ntz = r.tz + (child ? o + W : o);
     float *th = r.state(TH, i), *ph = r.state(PH, i), *dth = r.state(DTH, i), *dph = r.state(DPH, i);
     const float *px = r.px + o, *py = r.py + o, *pz = r.pz + o;
+    const float* len = r.field(FLEN, i);
+    LANES {
+      const bool free = iw[l] != 0.0f;
+      const float sx = spx[l] + dth[l] * A[l] + dph[l] * Y[l];
+      const float sy = spy[l] + dth[l] * A[W + l] + dph[l] * Y[W + l];
+      const float sz = spz[l] + dth[l] * A[2 * W + l] + dph[l] * Y[2 * W + l];
+      const float ex = len[l] * Z[l], ey = len[l] * Z[W + l], ez = len[l] * Z[2 * W + l];
+      spx[l] = free ? sx : 0.0f;
+      spy[l] = free ? sy : 0.0f;
+      spz[l] = free ? sz : 0.0f;
+      ux[l] = free ? ux[l] + (sy * ez - sz * ey) : 0.0f;
+      uy[l] = free ? uy[l] + (sz * ex - sx * ez) : 0.0f;
+      uz[l] = free ? uz[l] + (sx * ey - sy * ex) : 0.0f;
+    }
     // External acceleration: gravity less the root's inertia, the wind's part normal to
-    // the segment, penalty forces of the spheres the end is inside.
+    // the segment, damped penalty forces of the spheres the end is inside.
     alignas(64) float ax[W], ay[W], az[W];
     LANES {
       const float x = px[l], y = py[l], z = pz[l];
@@ -181,23 +204,29 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
         const bool inside = dist2 < rad * rad;
         const float dist = std::sqrt(dist2);
         const bool off = dist > 0.0f;
-        const float g = inside ? push * (rad - dist) : 0.0f;
-        ax[l] += g * (off ? dx / dist : 0.0f);
-        ay[l] += g * (off ? dy / dist : 1.0f);
-        az[l] += g * (off ? dz / dist : 0.0f);
+        const float nx = off ? dx / dist : 0.0f, ny = off ? dy / dist : 1.0f, nz = off ? dz / dist : 0.0f;
+        const float depth = rad - dist, limit = damp * depth / dt;
+        const float d = damp * (ux[l] * nx + uy[l] * ny + uz[l] * nz);
+        const float g = inside ? push * depth - (d < -limit ? -limit : limit < d ? limit : d) : 0.0f;
+        ax[l] += g * nx;
+        ay[l] += g * ny;
+        az[l] += g * nz;
       }
     }
     LANES {
       const float zx = Z[l], zy = Z[W + l], zz = Z[2 * W + l];
-      // Gravity's torque on the head-transformed rest segment, subtracted where compensating.
+      // Where compensating, z × g_n is subtracted: g_n the part of gravity normal to the
+      // head-transformed rest segment z0 (forest_integrate).
       const float rzx = m0 * R2[l] + m1 * R2[fs + l] + m2 * R2[2 * fs + l];
       const float rzy = m3 * R2[l] + m4 * R2[fs + l] + m5 * R2[2 * fs + l];
       const float rzz = m6 * R2[l] + m7 * R2[fs + l] + m8 * R2[2 * fs + l];
+      const float along = gx * rzx + gy * rzy + gz * rzz;
+      const float nx = gx - along * rzx, ny = gy - along * rzy, nz = gz - along * rzz;
       const float il = gain[l];
       const float tx = zy * az[l] - zz * ay[l], ty = zz * ax[l] - zx * az[l], tz = zx * ay[l] - zy * ax[l];
-      const float cx = compensate ? tx - (rzy * gz - rzz * gy) : tx;
-      const float cy = compensate ? ty - (rzz * gx - rzx * gz) : ty;
-      const float cz = compensate ? tz - (rzx * gy - rzy * gx) : tz;
+      const float cx = compensate ? tx - (zy * nz - zz * ny) : tx;
+      const float cy = compensate ? ty - (zz * nx - zx * nz) : ty;
+      const float cz = compensate ? tz - (zx * ny - zy * nx) : tz;
       float accx = il * cx - r.tx[o + l], accy = il * cy - r.ty[o + l], accz = il * cz - r.tz[o + l];
       if (child) {
         accx += ntx[l];
@@ -214,8 +243,8 @@ void integrate(const Rows& r, const ForestSubstep& h, const ForestFrame& f, cons
       paz[l] = free ? accz : paz[l];
       th[l] = free ? th[l] + dth[l] * dt : th[l];
       ph[l] = free ? ph[l] + dph[l] * dt : ph[l];
-      dth[l] = free ? dth[l] + ddth * dt : dth[l];
-      dph[l] = free ? dph[l] + ddph * dt : dph[l];
+      dth[l] = free ? (dth[l] + ddth * dt) * keep : dth[l];
+      dph[l] = free ? (dph[l] + ddph * dt) * keep : dph[l];
     }
   }
 }

@@ -133,7 +133,9 @@ struct ForestFrame : soa::BlockFrame<ForestSubstep> {
 };
 struct ForestParams {
   float joint_damping;
+  float drag;  // s^-1; the joint rates are kept exp(-drag dt) a step (forest_integrate)
   float collision_stiffness;
+  float collision_damping;  // ζ of forest_integrate's damped penalty
 };
 using ForestFrameFn = void (*)(const Block& block, const ForestParams& params, const ForestFrame& frame, float* out,
                                float* scratch, soa::LineFeed& feed, std::int64_t* stage_ns);

@@ -255,6 +255,64 @@ float forest_setup(std::span<const Vec4f> rest, ForestAxes axes, float stiffness
   return 1.0f / arc[n - 1];
 }
 
+namespace {
+// Whether s K − C is positive definite for one chain's tridiagonal K (stiffness kk, see
+// forest_rest_stiffness_scale) and diagonal C: every pivot of its LDLᵀ factorisation > 0.
+bool chain_definite(std::span<const double> kk, std::span<const double> c, double s) {
+  double pivot = 0.0;
+  for (std::size_t j = 0; j < kk.size(); ++j) {
+    const double next = j + 1 < kk.size() ? kk[j + 1] : 0.0;
+    const double diagonal = s * (kk[j] + next) - c[j];
+    const double coupling = j > 0 ? s * kk[j] : 0.0;
+    pivot = j > 0 ? diagonal - coupling * coupling / pivot : diagonal;
+    if (!(pivot > 0.0)) return false;
+  }
+  return true;
+}
+
+// The smallest s with s K − C semi-definite, by bisection on definiteness (monotone in s,
+// K being definite); 0 where C has no positive entry.
+double chain_buckling_scale(std::span<const double> kk, std::span<const double> c) {
+  if (std::none_of(c.begin(), c.end(), [](double v) { return v > 0.0; })) return 0.0;
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 128 && !chain_definite(kk, c, hi); ++i) {
+    lo = hi;
+    hi *= 2.0;
+  }
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (chain_definite(kk, c, mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+}  // namespace
+
+float forest_rest_inertia_scale(std::span<const Vec4f> rest, std::span<const float> length,
+                                std::span<const float> k, float inv_strand_length, const Vec3f& gravity,
+                                double margin) {
+  const double g = gravity.cast<double>().norm();
+  if (!(g > 0.0)) return 1.0f;
+  const Eigen::Vector3d up = -gravity.cast<double>() / g;
+  double scale = 0.0;
+  std::vector<double> kk, c;
+  // Each run of free segments is a chain whose parent is rigid with the head.
+  for (std::size_t i = 1; i <= rest.size(); ++i) {
+    if (i < rest.size() && rest[i].w() != 0.0f) {
+      // A zero-length segment has no direction for gravity to turn.
+      const double l = length[i];
+      const double rise = l > 0.0 ? (xyz(rest[i]) - xyz(rest[i - 1])).cast<double>().dot(up) / l : 0.0;
+      kk.push_back(k[i]);
+      c.push_back(g * rise * double(inv_strand_length));
+      continue;
+    }
+    if (!kk.empty() && std::all_of(kk.begin(), kk.end(), [](double v) { return v > 0.0; }))
+      scale = std::max(scale, chain_buckling_scale(kk, c));
+    kk.clear();
+    c.clear();
+  }
+  return static_cast<float>(std::max(1.0, margin * scale));
+}
+
 Mat34f root_inertia(const Affine3f& head, const Affine3f& h1, const Affine3f& h0, float dt) {
   const Eigen::Matrix4f second = head.matrix() - 2.0f * h1.matrix() + h0.matrix();
   return (second * head.inverse(Eigen::Isometry).matrix()).topRows<3>() / (dt * dt);
@@ -282,8 +340,9 @@ void forest_pose(const ForestStrand& s, ForestAxes axes, const Affine3f& head) {
 namespace {
 // External acceleration at a free segment end: gravity, the part of the wind that meets
 // the segment face-on (as verlet_integrate), the inertial force of the moving root, and
-// a penalty pushing the end out of any sphere it is inside.
-Vec3f external_acceleration(const ForestForces& f, const Vec3f& p, const Vec3f& z) {
+// a penalty pushing the end out of any sphere it is inside, damped along the sphere's
+// normal: v is the end's velocity relative to the head.
+Vec3f external_acceleration(const ForestForces& f, const Vec3f& p, const Vec3f& z, const Vec3f& v) {
   const Vec3f root = f.inertia.leftCols<3>() * p + f.inertia.col(3);
   Vec3f a = f.gravity - root;
   if (f.wind.active()) {
@@ -291,6 +350,7 @@ Vec3f external_acceleration(const ForestForces& f, const Vec3f& p, const Vec3f& 
     a += w - w.dot(z) * z;
   }
   const float push = f.collision_stiffness / (f.dt * f.dt);
+  const float damp = 2.0f * f.collision_damping * std::sqrt(f.collision_stiffness) / f.dt;
   for (const Vec4f& sphere : f.spheres) {
     const Vec3f d = p - xyz(sphere);
     const float r = sphere.w();
@@ -298,7 +358,11 @@ Vec3f external_acceleration(const ForestForces& f, const Vec3f& p, const Vec3f& 
     if (dist2 >= r * r) continue;
     const float dist = std::sqrt(dist2);
     const Vec3f normal = dist > 0.0f ? Vec3f(d / dist) : Vec3f::UnitY();
-    a += push * (r - dist) * normal;
+    // The damping is held within damp · depth / dt, so the force still starts from 0 as the
+    // end enters the sphere: a jump there would let a rounding-sized difference of where
+    // the end is decide a finite difference of force.
+    const float depth = r - dist, limit = damp * depth / f.dt, along = damp * v.dot(normal);
+    a += (push * depth - (along < -limit ? -limit : limit < along ? limit : along)) * normal;
   }
   return a;
 }
@@ -320,14 +384,29 @@ void forest_integrate(const ForestStrand& s, ForestAxes axes, const ForestForces
                         (s.k[i] * (s.phi[i] - s.phi0[i]) + f.joint_damping * s.dphi[i]) * y;
   }
   Vec3f parent_acc = f.root_angular_acceleration;
+  // The segment's angular velocity and its end's velocity relative to the head, summed
+  // from the root over the joint rates (θ' about a_p, φ' about y: Eq. 4.2.6's state).
+  Vec3f spin = Vec3f::Zero(), velocity = Vec3f::Zero();
   for (std::size_t i = 1; i < n; ++i) {
-    if (s.rest[i].w() == 0.0f) continue;
+    if (s.rest[i].w() == 0.0f) {
+      spin = velocity = Vec3f::Zero();
+      continue;
+    }
     const Vec3f z = s.frame[i].col(2);
     const Vec3f p = xyz(s.pos[i]);
+    spin += s.dtheta[i] * s.frame[i - 1].col(primary) + s.dphi[i] * s.frame[i].col(1);
+    velocity += spin.cross(s.length[i] * z);
     // Eq. 4.2.1, 4.2.4 and 4.2.3: the external torque (less gravity's on the rest
     // segment) as an angular acceleration, minus the joint's own spring, plus its child's.
-    Vec3f torque = z.cross(external_acceleration(f, p, z));
-    if (f.gravity_compensation) torque -= (f.head_rotation * s.rest_frame[i].col(2)).cross(f.gravity);
+    Vec3f torque = z.cross(external_acceleration(f, p, z, velocity));
+    if (f.gravity_compensation) {
+      // The part of gravity normal to the head-transformed rest segment z0, as a constant
+      // force: z × g_n with g_n = g − (g · z0) z0 cancels gravity's torque in the rest pose
+      // and, being a force, does no net work round a closed path of the segment (a
+      // constant torque would: in 3D it pumps a segment that circles).
+      const Vec3f z0 = f.head_rotation * s.rest_frame[i].col(2);
+      torque -= z.cross(f.gravity - f.gravity.dot(z0) * z0);
+    }
     const float gain = f.inertia_model == ForestInertia::Mass ? s.length[i] : f.inv_inertia_length;
     Vec3f acc = gain * torque - s.joint_torque[i];
     if (i + 1 < n) acc += s.joint_torque[i + 1];
@@ -339,8 +418,8 @@ void forest_integrate(const ForestStrand& s, ForestAxes axes, const ForestForces
     // Eq. 4.2.6: explicit Euler, the angle advanced with the velocity of the step's start.
     s.theta[i] += s.dtheta[i] * f.dt;
     s.phi[i] += s.dphi[i] * f.dt;
-    s.dtheta[i] += ddtheta * f.dt;
-    s.dphi[i] += ddphi * f.dt;
+    s.dtheta[i] = (s.dtheta[i] + ddtheta * f.dt) * f.keep;
+    s.dphi[i] = (s.dphi[i] + ddphi * f.dt) * f.keep;
   }
 }
 

@@ -203,27 +203,64 @@ struct ForestForces {
   Mat3f head_rotation = Mat3f::Identity();
   std::span<const Vec4f> spheres;  // world xyz + radius
   float collision_stiffness = 0.0f;  // fraction of the penetration depth removed per dt²
+  // ζ: the penalty is damped along the sphere's normal at 2ζ √(collision_stiffness) / dt,
+  // ζ times critical for the penalty spring alone, by at most that rate times depth / dt.
+  float collision_damping = 0.0f;
   float joint_damping = 0.0f;        // v of Eq. 4.2.2, s^-1
+  // The fraction of every joint's rate kept after a step, exp(-drag dt): damping of each
+  // segment's rotation relative to the head (see forest_integrate).
+  float keep = 1.0f;
   float inv_inertia_length = 0.0f;   // 1 / ℓ, see ForestInertia
   float dt = 0.0f;
   ForestInertia inertia_model = ForestInertia::StrandPendulum;
-  // Subtract gravity's torque on the head-transformed rest segment, so that pose is in
-  // equilibrium (the forest's counterpart of the spring models' L = mg/k; not in §4.2,
-  // where gravity bends the strand until the joint springs hold it).
+  // Take the part of gravity normal to the head-transformed rest segment off as a force,
+  // so that pose is in equilibrium (the forest's counterpart of the spring models'
+  // L = mg/k; not in §4.2, where gravity bends the strand until the joint springs hold it).
   bool gravity_compensation = true;
   // Ω̇_p of Eq. 4.2.5 for the first free segment, whose parent is rigid with the head:
   // head_angular_acceleration, or zero to leave the head's motion to the inertial force.
   Vec3f root_angular_acceleration = Vec3f::Zero();
 };
 
+// How much one strand's inertia J = m L ℓ (ForestInertia::StrandPendulum) must be raised
+// so that its rest pose, held in equilibrium by gravity compensation, is a stable one: a
+// factor s >= 1 that divides the strand's external torques (1 where the pose already
+// stands). Linearised about the rest pose with the head at identity, a segment i turned
+// by a small angle about any axis normal to it meets gravity's torque |g| (z_i · up) / ℓ
+// per radian (Eq. 4.2.1 with τ = L z × m g, through Eq. 4.2.4's J), which pushes it
+// further over where the segment points up. The joint springs (Eq. 4.2.2-4.2.3) act on
+// the absolute angles α of a chain of free segments through the tridiagonal K of
+// (Kα)_i = k_i (α_i − α_{i−1}) − k_{i+1} (α_{i+1} − α_i), α fixed at the rigid root and
+// free at the tip, so the chain stands when K − C / s is positive definite,
+// C = diag(|g| (z_i · up) / ℓ). K's slowest mode falls as k / n² with the segment count n
+// while gravity's term does not, so an upright strand of many short segments (a mohawk, a
+// groom resampled finely) topples out of a pose that 16 vertices hold. s is `margin`
+// times the smallest factor that makes s K − C semi-definite: the strand would stand
+// under `margin` times its weight. Raising J rather than k leaves the explicit step's
+// bound (the fastest joint mode, about 4k) where it was. Zero gravity, or a joint without
+// stiffness (no factor helps), gives 1.
+float forest_rest_inertia_scale(std::span<const Vec4f> rest, std::span<const float> length,
+                                std::span<const float> k, float inv_strand_length, const Vec3f& gravity,
+                                double margin);
+// The margin the models use.
+inline constexpr double kForestRestMargin = 2.0;
+
 // One explicit Euler step of the joint angles (Eq. 4.2.1-4.2.6) from the pose in s.frame
 // and s.pos. External forces per unit mass at each segment end (gravity, wind normal to
 // the segment, the root's inertia, sphere penalty forces) become torques τ = L z × F
-// (4.2.1) and, through f.inertia_model's J (4.2.4), angular accelerations, less gravity's
-// on the head-transformed rest segment where f.gravity_compensation is set. The joint
+// (4.2.1) and, through f.inertia_model's J (4.2.4), angular accelerations, less z × g_n
+// where f.gravity_compensation is set, g_n the part of gravity normal to the
+// head-transformed rest segment (zero torque in that pose). The sphere penalty is damped
+// along the sphere's normal (f.collision_damping), with the end's velocity relative to
+// the head summed from the root over the joint rates. The joint
 // springs (4.2.2) of a segment and of its child are added (4.2.3), the parent's absolute
 // acceleration subtracted (4.2.5; f.root_angular_acceleration for the first free
-// segment) and the result projected on the joint axes.
+// segment) and the result projected on the joint axes. Last, the joint rates are scaled
+// by f.keep: taking d ω_i off every segment's absolute acceleration, ω_i its angular
+// velocity relative to the head, leaves −d (θ' a_p + φ' y) relative to the parent
+// (Eq. 4.2.5), each joint's own rates, so a drag on the segments' rotation is a per-joint
+// decay that, unlike Eq. 4.2.2's v (which joints pass to their parents), damps a
+// strand's slowest swing as fast as its fastest whatever its segment count.
 void forest_integrate(const ForestStrand& s, ForestAxes axes, const ForestForces& f);
 
 }  // namespace hairbench::kernels

@@ -32,8 +32,9 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
     Region g{1.0f, 1.0f, 0, {}};
     if (forest) {
-      g.forest = {static_cast<float>(params.get("joint_damping", r)),
-                  static_cast<float>(params.get("collision_stiffness", r))};
+      g.forest = {static_cast<float>(params.get("joint_damping", r)), static_cast<float>(params.get("drag", r)),
+                  static_cast<float>(params.get("collision_stiffness", r)),
+                  static_cast<float>(params.get("collision_damping", r))};
     } else {
       g.keep = 1.0f - static_cast<float>(params.get("damping", r));
       g.length_iterations = params.get_int("length_iterations", r);
@@ -144,6 +145,8 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
   forest_frame_.mass_inertia = forest && params.get_int("inertia") == 0;
   forest_frame_.gravity_compensation = forest && params.get_int("gravity_compensation") != 0;
   forest_root_angular_ = forest && params.get_int("root_angular_acceleration") != 0;
+  forest_rest_ = {};
+  forest_rest_.hold = forest && !forest_frame_.mass_inertia && params.get_int("rest_hold") != 0;
   if (!spring && !forest) {
     cascade_frames_ = static_cast<k::CascadeFrames>(params.get_int("frames"));
     cascade_reactions_ = params.get_int("reactions") != 0;
@@ -164,6 +167,12 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
     else
       inv_length_[s] = k::forest_setup(strand_rest, axes, static_cast<float>(params.get("joint_stiffness", r)), c, a,
                                        at(space), at(theta0), at(phi0), at(length), at(k_up));
+  }
+  if (forest_rest_.hold) {
+    forest_rest_.positions = rest.positions;
+    forest_rest_.length = length;
+    forest_rest_.k = k_up;
+    forest_rest_.strand_offsets = rest.strand_offsets;
   }
   const bool cascade = !spring && !forest;
   if (cascade)  // the cascade's own inverse masses (vertex 1 free) decide its rows' kinds
@@ -355,8 +364,36 @@ void HalenFusedModel::forest_substeps(const FrameInput& in, float dt) {
   forest_frame_.dt = dt;
 }
 
+// As halen_forest_ref: gravity reaches the model with the first frame, so the strands' J
+// is raised there, and again only if it changes; each block's gain row is rewritten.
+void HalenFusedModel::hold_rest(const Vec3f& gravity) {
+  ForestRest& fr = forest_rest_;
+  fr.gravity = gravity;
+  if (!fr.hold) return;
+  const std::size_t strands = fr.strand_offsets.size() - 1;
+  std::vector<float> gain(strands);
+  auto hold = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::size_t b = fr.strand_offsets[s], n = fr.strand_offsets[s + 1] - b;
+      gain[s] = inv_length_[s] / k::forest_rest_inertia_scale(std::span<const Vec4f>(fr.positions).subspan(b, n),
+                                                              std::span<const float>(fr.length).subspan(b, n),
+                                                              std::span<const float>(fr.k).subspan(b, n),
+                                                              inv_length_[s], gravity, k::kForestRestMargin);
+    }
+  };
+  if (ctx_.pool)
+    ctx_.pool->parallel_for(strands, hold);
+  else
+    hold(0, strands);
+  for (const BlockInfo& b : blocks_) {
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    for (int l = 0; l < W; ++l) data_[b.offset + static_cast<std::size_t>(soa::kForestFields) * rows + l] = gain[b.source[l]];
+  }
+}
+
 void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
   const bool forest = model_ == Model::Forest;
+  if (forest && in.gravity != forest_rest_.gravity) hold_rest(in.gravity);
   calm_ = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm_ && sleep_.all_asleep()) {
     // Every strand sleeps: nothing runs. The forest's head has been still for

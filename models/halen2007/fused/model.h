@@ -14,6 +14,7 @@
 #include "models/block_threads.h"
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -90,6 +91,18 @@ class HalenFusedModel final : public HairModel {
   bool forest_root_angular_ = false;  // the forest's root_angular_acceleration parameter
   Affine3f head_hist_[2];
   std::vector<float> inv_length_;  // forest: 1/ℓ per strand
+  // forest: the rest polyline, segment lengths and joint stiffness, from which each
+  // block's gain of the external torques (1/ℓ) is divided by
+  // kernels::forest_rest_inertia_scale for the gravity of the frame (rest_hold).
+  struct ForestRest {
+    bool hold = false;
+    std::vector<Vec4f> positions;
+    std::vector<float> length, k;
+    std::vector<std::uint32_t> strand_offsets;
+    Vec3f gravity = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  };
+  ForestRest forest_rest_;
+  void hold_rest(const Vec3f& gravity);
   kernels::CascadeFrames cascade_frames_ = kernels::CascadeFrames::Transport;  // cascade: "frames"
   bool cascade_reactions_ = true;                                              // cascade: "reactions"
   bool calm_ = false;

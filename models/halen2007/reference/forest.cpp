@@ -17,11 +17,16 @@ void ForestModel::reset(const Groom& rest, const ParamSet& params) {
   inertia_ = params.get_int("inertia") == 0 ? k::ForestInertia::Mass : k::ForestInertia::StrandPendulum;
   gravity_compensation_ = params.get_int("gravity_compensation") != 0;
   root_angular_acceleration_ = params.get_int("root_angular_acceleration") != 0;
+  rest_hold_ = inertia_ == k::ForestInertia::StrandPendulum && params.get_int("rest_hold") != 0;
   joint_damping_.clear();
+  drag_.clear();
   collision_stiffness_.clear();
+  collision_damping_.clear();
   for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
     joint_damping_.push_back(static_cast<float>(params.get("joint_damping", r)));
+    drag_.push_back(static_cast<float>(params.get("drag", r)));
     collision_stiffness_.push_back(static_cast<float>(params.get("collision_stiffness", r)));
+    collision_damping_.push_back(static_cast<float>(params.get("collision_damping", r)));
   }
 
   const std::size_t nv = rest.vertex_count();
@@ -39,6 +44,8 @@ void ForestModel::reset(const Groom& rest, const ParamSet& params) {
         std::span(rest_frame_).subspan(b, n), std::span(theta0_).subspan(b, n), std::span(phi0_).subspan(b, n),
         std::span(length_).subspan(b, n), std::span(k_).subspan(b, n));
   }
+  inv_inertia_length_ = inv_strand_length_;
+  held_for_ = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
   theta_ = theta0_;
   phi_ = phi0_;
   dtheta_.assign(nv, 0.0f);
@@ -89,7 +96,25 @@ void ForestModel::pose(const Affine3f& head) {
   for_each_strand([&](std::size_t s) { k::forest_pose(strand_view(s), axes_, head); });
 }
 
+// Gravity reaches the model with the first frame, so the strands' J is raised there, and
+// again only if it changes.
+void ForestModel::hold_rest(const Vec3f& gravity) {
+  held_for_ = gravity;
+  if (!rest_hold_) return;
+  ctx_.pool->parallel_for(rest_.strand_count(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+      inv_inertia_length_[s] =
+          inv_strand_length_[s] / k::forest_rest_inertia_scale(std::span<const Vec4f>(rest_.positions).subspan(b, n),
+                                                               std::span<const float>(length_).subspan(b, n),
+                                                               std::span<const float>(k_).subspan(b, n),
+                                                               inv_strand_length_[s], gravity, k::kForestRestMargin);
+    }
+  });
+}
+
 void ForestModel::step(const FrameInput& in, StageTimes& times) {
+  if (in.gravity != held_for_) hold_rest(in.gravity);
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
   const bool calm = sleep_.begin_step(in, ctx_.skip_inert);
   if (calm && sleep_.all_asleep()) {
@@ -127,8 +152,10 @@ void ForestModel::step(const FrameInput& in, StageTimes& times) {
       k::ForestForces fs = f;
       const std::size_t r = rest_.strand_region[s];
       fs.joint_damping = joint_damping_[r];
+      fs.keep = std::exp(-drag_[r] * dt);
       fs.collision_stiffness = collision_stiffness_[r];
-      fs.inv_inertia_length = inv_strand_length_[s];
+      fs.collision_damping = collision_damping_[r];
+      fs.inv_inertia_length = inv_inertia_length_[s];
       k::forest_integrate(strand_view(s), axes_, fs);
     });
   }

@@ -14,6 +14,7 @@
 #include "core/sleep.h"
 #include "kernels/halen2007/reference/halen_kernels.h"
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -43,8 +44,15 @@ class ForestModel final : public HairModel {
   std::vector<float> length_, theta0_, phi0_, k_;
   std::vector<Vec3f> joint_torque_;
   std::vector<float> theta_, phi_, dtheta_, dphi_;
+  void hold_rest(const Vec3f& gravity);
+
   std::vector<float> inv_strand_length_;  // 1/ℓ per strand
-  std::vector<float> joint_damping_, collision_stiffness_;  // per region
+  // Per strand, the gain of the external torques under J = m L ℓ: 1/ℓ, divided by
+  // kernels::forest_rest_inertia_scale for the gravity it was last given (rest_hold).
+  std::vector<float> inv_inertia_length_;
+  bool rest_hold_ = true;
+  Vec3f held_for_ = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  std::vector<float> joint_damping_, drag_, collision_stiffness_, collision_damping_;  // per region
   int substeps_ = 1;
   Affine3f head_hist_[2];  // head transforms of the last two substeps (the root's inertia)
   std::vector<Vec4f> pos_;
