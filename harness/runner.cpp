@@ -264,6 +264,7 @@ class LockstepRun {
   void snapshot(const FrameInput& in, int f, int frames);
   void record_scenario(int frames) const;
   void time_gpu_lanes();
+  void extend_settle(int frames);
 
   const Scenario& sc_;
   const RunOptions& opt_;
@@ -736,6 +737,40 @@ void LockstepRun::time_gpu_lanes() {
   }
 }
 
+// verdict::SettleCheck::kExtraSeconds: a lane whose motion has not decayed by the
+// scenario's end steps on alone, head still at its last pose and no wind, and its settle
+// check reads the longer window. After the state hash, snapshots and series are taken, so
+// nothing else in the report sees these frames; not timed.
+void LockstepRun::extend_settle(int frames) {
+  const FrameInput last = frame_input(sc_, frames - 1);
+  const int extra = static_cast<int>(std::lround(verdict::SettleCheck::kExtraSeconds / sc_.dt));
+  for (Lane& l : lanes_) {
+    const verdict::Settle s = l.settle.result();
+    if (!l.running || l.record.failure || s.decays || s.frames < verdict::SettleCheck::kMinFrames) continue;
+    StageTimes times;
+    for (int k = 0; k < extra; ++k) {
+      FrameInput in = last;
+      in.frame = frames + k;
+      in.t = (frames + k + 1) * sc_.dt;
+      in.head_prev = in.head = last.head;
+      in.wind = {};
+      l.model->step(in, times);
+      times.clear();
+      double kinetic = 0.0;
+      if (l.device) {
+        l.strands = l.device->measure({in.head, Affine3f::Identity(), sc_.gravity, static_cast<float>(sc_.dt),
+                                       spheres_, {}});
+        kinetic = metrics::relative_kinetic_energy(rest_, l.strands, sc_.dt);
+      } else {
+        const auto p = l.model->positions();
+        kinetic = verdict::relative_kinetic_energy(p, l.prev, in.head, in.head, sc_.dt);
+        l.prev.assign(p.begin(), p.end());
+      }
+      l.settle.add_past_end(in.t, kinetic);
+    }
+  }
+}
+
 std::vector<RunRecord> LockstepRun::run() {
   make_lanes();
   // Once every lane is made (the CPU models' probes take a while): the GPU models' clock
@@ -763,10 +798,12 @@ std::vector<RunRecord> LockstepRun::run() {
   if (opt_.scenario_record) record_scenario(frames);
   time_gpu_lanes();
 
+  for (Lane& l : lanes_) l.record.state_hash = metrics::state_hash(l.model->positions());
+  extend_settle(frames);
+
   std::vector<RunRecord> out;
   for (Lane& l : lanes_) {
     RunRecord& r = l.record;
-    r.state_hash = metrics::state_hash(l.model->positions());
     std::optional<std::pair<int, double>> stop;
     if (r.failure) stop = std::make_pair(r.failure->frame, r.failure->t);
     r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", l.stretch.result(), l.settle.result(),

@@ -1,5 +1,6 @@
 #include "reports/verdict.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hairbench::verdict {
@@ -30,9 +31,16 @@ void SettleCheck::add(double t, double energy, bool driven, double settle_from) 
   e_.push_back(energy);
 }
 
+void SettleCheck::add_past_end(double t, double energy) {
+  t_.push_back(t);
+  e_.push_back(energy);
+  ++extra_;
+}
+
 Settle SettleCheck::result() const {
   Settle s;
   s.frames = static_cast<int>(e_.size());
+  s.extra_frames = extra_;
   if (s.frames < kMinFrames) return s;
   const std::size_t half = e_.size() / 2;
   auto mean = [](const std::vector<double>& v, std::size_t b, std::size_t e) {
@@ -44,9 +52,12 @@ Settle SettleCheck::result() const {
   s.energy_second = mean(e_, e_.size() - half, e_.size());
   const double span = mean(t_, e_.size() - half, e_.size()) - mean(t_, 0, half);
   s.rate = std::log(s.energy_second / s.energy_first) / span;
+  const double peak_first = *std::max_element(e_.begin(), e_.begin() + static_cast<std::ptrdiff_t>(half));
+  const double peak_second = *std::max_element(e_.end() - static_cast<std::ptrdiff_t>(half), e_.end());
+  s.peak_rate = std::log(peak_second / peak_first) / span;
   const double floor = 0.5 * kRestSpeed * kRestSpeed;
   // NaN energy (a non-finite state) fails the comparisons and so counts as not decaying.
-  s.decays = s.energy_second < floor || s.rate <= -kMinDecayRate;
+  s.decays = s.energy_second < floor || (s.rate <= -kMinDecayRate && s.peak_rate <= -kMinDecayRate);
   return s;
 }
 
@@ -86,6 +97,11 @@ Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::str
                   "motion does not decay with the head still: kinetic energy %.3g -> %.3g m^2/s^2 (%.3g/s)",
                   settle.energy_first, settle.energy_second, settle.rate);
     v.reason = buf;
+    if (settle.extra_frames > 0) {
+      std::snprintf(buf, sizeof buf, " over %.3g s, %.3g s of them past the scenario's end", settle.frames * dt,
+                    settle.extra_frames * dt);
+      v.reason += buf;
+    }
   } else if (stretch.frames_above > 0) {
     v.status = Status::stretched;
     std::snprintf(buf, sizeof buf, "edge length error %.3g (strand %u, edge %u) above %.2g in %d frames",
@@ -115,9 +131,11 @@ nlohmann::json verdict_json(const Verdict& v) {
                         {"frames_above", v.stretch.frames_above}}},
                       {"settle",
                        {{"frames", v.settle.frames},
+                        {"extra_frames", v.settle.extra_frames},
                         {"energy_first", num(v.settle.energy_first)},
                         {"energy_second", num(v.settle.energy_second)},
                         {"rate", num(v.settle.rate)},
+                        {"peak_rate", num(v.settle.peak_rate)},
                         {"decays", v.settle.decays}}}};
   if (v.probe.run)
     j["probe"] = {{"kick", num(v.probe.kick)},

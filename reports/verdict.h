@@ -56,8 +56,8 @@ class StretchTracker {
 // the head holds still and no wind blows, the kinetic energy per unit mass relative to
 // the head, mean |p - H H_prev^-1 p_prev|^2 / (2 dt^2), is averaged over the first and
 // the second half of those frames, and its rate ln(second / first) / (time between the
-// halves' centres) taken. The motion has not decayed when that rate is above
-// -kMinDecayRate while the second half stays above the floor of hair at rest (every
+// halves' centres) taken, and the same rate of the halves' peaks. The motion has not
+// decayed when either rate is above -kMinDecayRate while the second half stays above the floor of hair at rest (every
 // vertex slower than kRestSpeed): it grows, or holds a limit cycle (contact chatter, a
 // self-excited flutter). The window is about a second, too short to tell a limit cycle
 // from a decay much slower than kMinDecayRate; a damped model's energy falls faster
@@ -65,10 +65,15 @@ class StretchTracker {
 // substeps and 60 Hz removes energy at about 76/s).
 struct Settle {
   int frames = 0;                                          // still frames after settle_from
+  int extra_frames = 0;  // of those, frames stepped past the scenario's end (SettleCheck::kExtraSeconds)
   double energy_first = std::numeric_limits<double>::quiet_NaN();   // m^2/s^2, first half's mean
   double energy_second = std::numeric_limits<double>::quiet_NaN();  // second half's mean
   // ln(energy_second / energy_first) / (time between the halves' centres), 1/s: < 0 decays.
   double rate = std::numeric_limits<double>::quiet_NaN();
+  // The same rate of the halves' largest energies. A swing's energy peaks twice a period;
+  // its halves' means depend on the phase where a half ends, its peaks do not once each
+  // half holds one, so a limit cycle that the means read as decaying keeps peak_rate ~0.
+  double peak_rate = std::numeric_limits<double>::quiet_NaN();
   bool decays = true;
 };
 
@@ -79,14 +84,23 @@ class SettleCheck {
   // 1 mm/s: 1/100 of a strand length of 10 cm per second, invisible at 60 Hz.
   static constexpr double kRestSpeed = 1e-3;
   static constexpr int kMinFrames = 20;  // fewer still frames than this: no verdict
+  // A second of frames cannot tell a slow swing's decay from growth: its kinetic energy
+  // rises and falls twice a period, and halves shorter than that sample it at different
+  // phases. A run whose check says "not decayed" at the scenario's end goes on for this
+  // long, head still and no wind, outside the timed run and its series, and the check
+  // reads the whole window: a decaying swing then passes, growth and a limit cycle do not.
+  static constexpr double kExtraSeconds = 3.0;
 
   // One frame's relative kinetic energy; counted when the frame ends at or after
   // settle_from and nothing drove the hair during it.
   void add(double t, double energy, bool driven, double settle_from);
+  // One frame stepped past the scenario's end (kExtraSeconds): always counted.
+  void add_past_end(double t, double energy);
   Settle result() const;
 
  private:
   std::vector<double> t_, e_;
+  int extra_ = 0;
 };
 
 // Kinetic energy per unit mass relative to the head between two frames (see Settle).

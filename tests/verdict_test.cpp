@@ -24,6 +24,7 @@ using verdict::Status;
 namespace {
 
 constexpr double kDt = 1.0 / 60.0;
+constexpr double kMinDecay = verdict::SettleCheck::kMinDecayRate;
 
 // Kinetic energy e(t) on every frame of a 2 s still window after settle_from = 0.
 verdict::Settle settle_of(const std::function<double(double)>& e) {
@@ -51,6 +52,34 @@ TEST(SettleCheck, DampedMotionDecaysAndAFlutterDoesNot) {
   EXPECT_TRUE(settle_of([&](double t) { return 1e-3 * floor * (1.0 + t); }).decays);
   // NaN energy is not decay.
   EXPECT_FALSE(settle_of([](double) { return std::nan(""); }).decays);
+}
+
+// A slow swing dying away: kinetic energy e^(-t) sin²(ω t) with a 2.6 s period. Over one
+// second its halves sample different phases and the energy reads as rising; over the
+// frames stepped past the scenario's end (kExtraSeconds) the decay shows. A limit cycle
+// of the same period: over four seconds the halves' means read it as decaying, their
+// peaks hold, and it still does not decay.
+TEST(SettleCheck, FramesPastTheEndSeparateASlowDecayFromALimitCycle) {
+  const double omega = 2.0 * M_PI / 2.6;
+  auto check = [&](double decay, double phase) {
+    verdict::SettleCheck c;
+    auto energy = [&](double t) { return 0.01 * std::exp(-decay * t) * std::pow(std::sin(omega * t + phase), 2); };
+    for (int f = 0; f < 60; ++f) c.add((f + 1) * kDt, energy((f + 1) * kDt), false, 0.0);
+    const verdict::Settle scenario = c.result();
+    const int extra = static_cast<int>(std::lround(verdict::SettleCheck::kExtraSeconds / kDt));
+    for (int f = 60; f < 60 + extra; ++f) c.add_past_end((f + 1) * kDt, energy((f + 1) * kDt));
+    return std::make_pair(scenario, c.result());
+  };
+  const auto [swing_short, swing] = check(1.0, 0.0);
+  EXPECT_FALSE(swing_short.decays) << "the premise: one second reads this decay as growth (rate " << swing_short.rate
+                                   << ")";
+  EXPECT_TRUE(swing.decays) << swing.rate;
+  EXPECT_EQ(swing.extra_frames, 180);
+  EXPECT_EQ(swing.frames, 240);
+  const auto cycle = check(0.0, 0.6).second;
+  EXPECT_FALSE(cycle.decays) << cycle.rate;
+  EXPECT_LT(cycle.rate, -kMinDecay) << "the premise: the halves' means read this cycle as decaying";
+  EXPECT_NEAR(cycle.peak_rate, 0.0, 1e-3);
 }
 
 TEST(SettleCheck, CountsOnlyStillFramesAfterTheSettleTime) {
