@@ -395,7 +395,7 @@ int run_batches(CompareArgs& a, bool sweep) {
   int total = 0;
   for (const PlanItem& it : plan.items) total += it.shard == mine;
 
-  double models_s = 0.0, runs_s = 0.0;
+  double models_s = 0.0, runs_s = 0.0, probes_s = 0.0, setup_s = 0.0, extra_s = 0.0;
   ThreadPool pool(a.threads);
   Progress progress(total, true);
   std::vector<RunRecord> runs;
@@ -433,6 +433,9 @@ int run_batches(CompareArgs& a, bool sweep) {
       for (const RunRecord& r : got) {
         print_run(run_json(r));
         for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
+        probes_s += r.probe_s;
+        setup_s += r.setup_s;
+        extra_s += r.settle_extra_s;
       }
       std::fflush(stdout);
       for (RunRecord& r : got) runs.push_back(std::move(r));
@@ -441,8 +444,10 @@ int run_batches(CompareArgs& a, bool sweep) {
   // Stepping the models is what a comparison measures; the rest is overhead.
   if (!a.groom.empty())
     std::printf("time: load %.3f s (read, repairs, follow hairs), fit %.3f s (unit, head sphere, collider), "
-                "model steps %.3f s, metrics, probes and verdicts %.3f s\n",
-                groom_times.load_s, groom_times.fit_s, models_s, runs_s - models_s);
+                "model steps %.3f s, the models' probes %.3f s, setup %.3f s and steps past the end %.3f s, "
+                "metrics and the rest %.3f s\n",
+                groom_times.load_s, groom_times.fit_s, models_s, probes_s, setup_s, extra_s,
+                runs_s - models_s - probes_s - setup_s - extra_s);
   nlohmann::json sweep_json;
   if (a.knob) sweep_json = {{"knob", knob_name}, {"values", values}, {"models", a.run.models}};
   return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan);

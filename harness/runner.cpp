@@ -138,7 +138,7 @@ std::optional<SubstepsChoice> choose_substeps(const ModelInfo& model, const Scen
   if (!model.step_bound || !resolved.has("substeps")) return std::nullopt;
   bool given = false, asked = false;
   for (const ParamOverride& o : overrides) given |= o.name == "substeps" && (o.model == "*" || o.model == model.name);
-  for (const std::string key : {std::string("*"), std::string(model.name)}) {
+  for (const std::string& key : {std::string("*"), std::string(model.name)}) {
     const auto it = sc.models.find(key);
     if (it == sc.models.end()) continue;
     given |= it->second.base.contains("substeps");
@@ -265,6 +265,8 @@ class LockstepRun {
   void record_scenario(int frames) const;
   void time_gpu_lanes();
   void extend_settle(int frames);
+  // The lane's stretch, with whether its worst edge ends at a pinned vertex.
+  verdict::Stretch stretch_of(const Lane& l) const;
 
   const Scenario& sc_;
   const RunOptions& opt_;
@@ -410,12 +412,17 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
                            const std::vector<ParamOverride>& overrides) {
   // The probe first: a model whose rest state is unstable must not sleep, or sleeping
   // would freeze the growth it is about to show (and change its metrics).
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
   verdict::Probe probe;
   if (opt_.probe) probe = perturbation_probe(*info, sc_, params, pool_, opt_.device);
+  const auto probed = Clock::now();
   const bool skip = opt_.skip_inert && !(probe.run && probe.grows);
   Lane lane{info, params, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
             metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe};
   RunRecord& r = lane.record;
+  r.probe_s = std::chrono::duration<double>(probed - start).count();
+  r.setup_s = std::chrono::duration<double>(Clock::now() - probed).count();
   r.scenario = sc_.name;
   r.model = std::string(info->name);
   const Backend backend = lane.model->backend();
@@ -747,8 +754,12 @@ void LockstepRun::extend_settle(int frames) {
   for (Lane& l : lanes_) {
     const verdict::Settle s = l.settle.result();
     if (!l.running || l.record.failure || s.decays || s.frames < verdict::SettleCheck::kMinFrames) continue;
+    const auto start = std::chrono::steady_clock::now();
     StageTimes times;
+    // verdict::EnergySpread: each strand's share over the last half of these frames.
+    std::vector<double> per_strand(sc_.groom.strand_count(), 0.0);
     for (int k = 0; k < extra; ++k) {
+      const bool spread = k >= extra / 2;
       FrameInput in = last;
       in.frame = frames + k;
       in.t = (frames + k + 1) * sc_.dt;
@@ -761,14 +772,44 @@ void LockstepRun::extend_settle(int frames) {
         l.strands = l.device->measure({in.head, Affine3f::Identity(), sc_.gravity, static_cast<float>(sc_.dt),
                                        spheres_, {}});
         kinetic = metrics::relative_kinetic_energy(rest_, l.strands, sc_.dt);
+        if (spread)
+          for (std::size_t s = 0; s < per_strand.size(); ++s) per_strand[s] += l.strands[s].kinetic;
       } else {
         const auto p = l.model->positions();
         kinetic = verdict::relative_kinetic_energy(p, l.prev, in.head, in.head, sc_.dt);
+        // The head holds still, so the energy relative to it is the plain |p - prev|^2.
+        if (spread)
+          for (std::size_t s = 0; s < per_strand.size(); ++s)
+            for (std::uint32_t v = sc_.groom.strand_begin(s); v < sc_.groom.strand_offsets[s + 1]; ++v)
+              per_strand[s] += static_cast<double>((p[v] - l.prev[v]).head<3>().squaredNorm());
         l.prev.assign(p.begin(), p.end());
       }
       l.settle.add_past_end(in.t, kinetic);
     }
+    // Follow hairs are rebuilt from their guide: their motion is the guide's, so it counts
+    // towards the guide, the strand a user would look at.
+    if (sc_.follow) {
+      const std::size_t guides = sc_.guides.strand_count();
+      for (std::size_t f = 0; f < sc_.follow->strand_count(); ++f)
+        per_strand[sc_.follow->guide[f]] += per_strand[guides + f];
+      per_strand.resize(guides);
+    }
+    verdict::EnergySpread spread = verdict::energy_spread(per_strand);
+    spread.guides = sc_.follow.has_value();
+    l.settle.set_spread(spread);
+    l.record.settle_extra_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+}
+
+verdict::Stretch LockstepRun::stretch_of(const Lane& l) const {
+  verdict::Stretch s = l.stretch.result();
+  const Groom& simulated = sc_.follow ? sc_.guides : sc_.groom;
+  if (s.frames_above > 0 && s.worst_strand < simulated.strand_count() && s.worst_edge >= 2 &&
+      s.worst_edge < simulated.strand_size(s.worst_strand)) {
+    const Vec4f* p = simulated.positions.data() + simulated.strand_begin(s.worst_strand);
+    s.pinned_end = (p[s.worst_edge].w() == 0.0f) != (p[s.worst_edge - 1].w() == 0.0f);
+  }
+  return s;
 }
 
 std::vector<RunRecord> LockstepRun::run() {
@@ -806,7 +847,7 @@ std::vector<RunRecord> LockstepRun::run() {
     RunRecord& r = l.record;
     std::optional<std::pair<int, double>> stop;
     if (r.failure) stop = std::make_pair(r.failure->frame, r.failure->t);
-    r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", l.stretch.result(), l.settle.result(),
+    r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", stretch_of(l), l.settle.result(),
                                 l.probe, sc_.dt);
     if (l.reported) out.push_back(std::move(r));
   }

@@ -264,7 +264,8 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
         {"ms_saved", num(static_cast<double>(asleep.size()) * med - asleep_ms)}}},
       {"stage_ms", stage},
       {"stage_skipped_steps", r.stage_skipped_steps},
-      {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))}};
+      {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))},
+      {"overhead_s", {{"probe", r.probe_s}, {"setup", r.setup_s}, {"settle_extra", r.settle_extra_s}}}};
 
   if (r.stream_ms > 0.0) {
     timing["state_bytes"] = r.state_bytes;

@@ -67,6 +67,10 @@ struct RunRecord {
   // (harness/roofline.h), CPU models only: timing.roofline_ratio.
   std::size_t state_bytes = 0;
   double stream_ms = 0.0;
+  // Wall time outside the timed steps that is the model's own work: its perturbation probe
+  // at rest, making and resetting it, and the frames stepped past the scenario's end for
+  // the settle check (timing.overhead_s).
+  double probe_s = 0.0, setup_s = 0.0, settle_extra_s = 0.0;
 
   // Parameters given to the reference on top of the scenario's (--reference converged);
   // empty when the reference runs at the scenario's parameters.

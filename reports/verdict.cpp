@@ -37,10 +37,34 @@ void SettleCheck::add_past_end(double t, double energy) {
   ++extra_;
 }
 
+EnergySpread energy_spread(std::span<const double> per_strand) {
+  EnergySpread out;
+  double total = 0.0;
+  for (double e : per_strand) total += e;
+  if (!(total > 0.0) || !std::isfinite(total)) return out;
+  std::vector<std::uint32_t> order(per_strand.size());
+  for (std::uint32_t s = 0; s < order.size(); ++s) order[s] = s;
+  // Largest first; ties by index, so the answer does not depend on the sort.
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return per_strand[a] != per_strand[b] ? per_strand[a] > per_strand[b] : a < b;
+  });
+  out.strands = per_strand.size();
+  out.strand = order[0];
+  out.share = per_strand[order[0]] / total;
+  double held = 0.0;
+  for (std::uint32_t s : order) {
+    held += per_strand[s];
+    ++out.strands_for_90;
+    if (held >= 0.9 * total) break;
+  }
+  return out;
+}
+
 Settle SettleCheck::result() const {
   Settle s;
   s.frames = static_cast<int>(e_.size());
   s.extra_frames = extra_;
+  s.spread = spread_;
   if (s.frames < kMinFrames) return s;
   const std::size_t half = e_.size() / 2;
   auto mean = [](const std::vector<double>& v, std::size_t b, std::size_t e) {
@@ -80,7 +104,7 @@ Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::str
   v.stretch = stretch;
   v.settle = settle;
   v.probe = probe;
-  char buf[160];
+  char buf[200];
   if (stop) {
     v.status = Status::diverged;
     v.reason = diverged;
@@ -104,11 +128,23 @@ Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::str
     }
   } else if (stretch.frames_above > 0) {
     v.status = Status::stretched;
-    std::snprintf(buf, sizeof buf, "edge length error %.3g (strand %u, edge %u) above %.2g in %d frames",
-                  stretch.peak, stretch.worst_strand, stretch.worst_edge, kStretchLimit, stretch.frames_above);
+    std::snprintf(buf, sizeof buf, "edge length error %.3g (strand %u, edge %u%s) above %.2g in %d frames",
+                  stretch.peak, stretch.worst_strand, stretch.worst_edge,
+                  stretch.pinned_end ? ", between a free and a pinned vertex" : "", kStretchLimit,
+                  stretch.frames_above);
     v.reason = buf;
     v.frame = stretch.peak_frame;
     v.t = (stretch.peak_frame + 1) * dt;
+  }
+  // Where the motion that outlasted the scenario is, whichever detector found it.
+  if (v.status == Status::unstable && settle.spread.strands > 0) {
+    const char* what = settle.spread.guides ? "guide" : "strand";
+    std::snprintf(buf, sizeof buf, "; %s in %zu of %zu %ss%s, %.3g%% in %s %u",
+                  settle.decays ? "past the scenario's end, 90% of the motion" : "90% of it",
+                  settle.spread.strands_for_90, settle.spread.strands, what,
+                  settle.spread.guides ? " (with their follow hairs)" : "", 100.0 * settle.spread.share, what,
+                  settle.spread.strand);
+    v.reason += buf;
   }
   return v;
 }
@@ -128,7 +164,8 @@ nlohmann::json verdict_json(const Verdict& v) {
                         {"peak_frame", v.stretch.peak_frame},
                         {"worst_strand", v.stretch.worst_strand},
                         {"worst_edge", v.stretch.worst_edge},
-                        {"frames_above", v.stretch.frames_above}}},
+                        {"frames_above", v.stretch.frames_above},
+                        {"pinned_end", v.stretch.pinned_end}}},
                       {"settle",
                        {{"frames", v.settle.frames},
                         {"extra_frames", v.settle.extra_frames},
@@ -136,7 +173,14 @@ nlohmann::json verdict_json(const Verdict& v) {
                         {"energy_second", num(v.settle.energy_second)},
                         {"rate", num(v.settle.rate)},
                         {"peak_rate", num(v.settle.peak_rate)},
-                        {"decays", v.settle.decays}}}};
+                        {"decays", v.settle.decays},
+                        {"spread", v.settle.spread.strands == 0
+                                       ? nlohmann::json(nullptr)
+                                       : nlohmann::json{{"strands", v.settle.spread.strands},
+                                                        {"strands_for_90", v.settle.spread.strands_for_90},
+                                                        {"strand", v.settle.spread.strand},
+                                                        {"guides", v.settle.spread.guides},
+                                                        {"share", num(v.settle.spread.share)}}}}}};
   if (v.probe.run)
     j["probe"] = {{"kick", num(v.probe.kick)},
                   {"first", num(v.probe.first)},

@@ -40,6 +40,9 @@ struct Stretch {
   int peak_frame = -1;
   std::uint32_t worst_strand = 0, worst_edge = 0;  // where the peak was
   int frames_above = 0;     // frames whose largest edge error exceeds kStretchLimit
+  // The worst edge joins a free vertex to one the groom pins past the root edge (a TressFX
+  // strand tied at its tip, say): a model that cannot close the loop stretches it there.
+  bool pinned_end = false;
 };
 
 class StretchTracker {
@@ -63,6 +66,20 @@ class StretchTracker {
 // from a decay much slower than kMinDecayRate; a damped model's energy falls faster
 // than that by orders of magnitude (a velocity damping of 0.1 per substep at six
 // substeps and 60 Hz removes energy at about 76/s).
+// Where motion that has not decayed is: the relative kinetic energy per strand, summed
+// over the last half of the frames stepped past the scenario's end. A flutter of one
+// strand and a whole groom that will not settle read the same in the groom's mean; this
+// tells them apart and names the strand to look at.
+struct EnergySpread {
+  std::size_t strands = 0;         // strands measured; 0: not measured
+  std::size_t strands_for_90 = 0;  // the fewest strands that hold 90% of the energy
+  std::uint32_t strand = 0;        // the strand with the most
+  double share = std::numeric_limits<double>::quiet_NaN();  // its fraction of the energy
+  bool guides = false;  // the strands are guides, each with its follow hairs' energy
+};
+// From per-strand energies; strands = 0 when their sum is not positive and finite.
+EnergySpread energy_spread(std::span<const double> per_strand);
+
 struct Settle {
   int frames = 0;                                          // still frames after settle_from
   int extra_frames = 0;  // of those, frames stepped past the scenario's end (SettleCheck::kExtraSeconds)
@@ -75,6 +92,7 @@ struct Settle {
   // half holds one, so a limit cycle that the means read as decaying keeps peak_rate ~0.
   double peak_rate = std::numeric_limits<double>::quiet_NaN();
   bool decays = true;
+  EnergySpread spread;  // measured when frames past the end were stepped
 };
 
 class SettleCheck {
@@ -96,11 +114,13 @@ class SettleCheck {
   void add(double t, double energy, bool driven, double settle_from);
   // One frame stepped past the scenario's end (kExtraSeconds): always counted.
   void add_past_end(double t, double energy);
+  void set_spread(const EnergySpread& spread) { spread_ = spread; }
   Settle result() const;
 
  private:
   std::vector<double> t_, e_;
   int extra_ = 0;
+  EnergySpread spread_;
 };
 
 // Kinetic energy per unit mass relative to the head between two frames (see Settle).

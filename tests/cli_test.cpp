@@ -389,10 +389,15 @@ TEST(Cli, CompareGroomFitsRunsAndScenarioNewWrites) {
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* line : {"unit cm (guessed: median strand 11 file units = 0.11 m", "pivot [5.326, 10.65, -1.855]",
                            "not a scalp", "head radius", "colliders: r", "repairs:", "substeps ", "(auto; ",
-                           "time: load"})
+                           "time: load", "the models' probes"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " in: " << r.out;
   const nlohmann::json a = read_report(out / "auto");
   ASSERT_EQ(a["runs"].size(), 2u);
+  // Each model's probe at rest ran outside its timed steps, and is timed on its own.
+  for (const auto& run_json : a["runs"]) {
+    EXPECT_GT(run_json["timing"]["overhead_s"]["probe"].get<double>(), 0.0) << run_json["model"];
+    EXPECT_GT(run_json["timing"]["overhead_s"]["setup"].get<double>(), 0.0) << run_json["model"];
+  }
   EXPECT_EQ(a["runs"][1]["model"], "halen_spring");
   EXPECT_EQ(a["runs"][1]["substeps"]["source"], "auto");
   EXPECT_GE(a["runs"][1]["substeps"]["value"].get<int>(), 6);  // never under the model's default

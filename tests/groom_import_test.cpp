@@ -18,6 +18,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 namespace fs = std::filesystem;
 using namespace hairbench;
@@ -209,8 +210,13 @@ TEST(GroomScenario, FitsEverythingFromTheGroomAlone) {
   // The collider is the head sphere shrunk until no free rest vertex is inside it.
   ASSERT_EQ(sc.colliders.size(), 1u);
   EXPECT_LE(sc.colliders[0].radius, sc.head_radius);
+  // The nearest free rest vertex stays a clearance outside it, not on its surface, where
+  // rounding would decide whether a model finds it inside.
+  float nearest = std::numeric_limits<float>::infinity();
   for (const Vec4f& p : sc.groom.positions)
-    if (p.w() != 0.0f) EXPECT_GE((p.head<3>() - sc.colliders[0].center).norm(), sc.colliders[0].radius);
+    if (p.w() != 0.0f) nearest = std::min(nearest, (p.head<3>() - sc.colliders[0].center).norm());
+  EXPECT_EQ(sc.colliders[0].radius, nearest * (1.0f - tfx::kColliderClearance));
+  EXPECT_GT(nearest - sc.colliders[0].radius, 1e-4f);
   EXPECT_EQ(error_of([] { groom_scenario_json(kMohawk, "x", "moonwalk", "auto"); }).rfind(
                 "--motion: moonwalk: not a built-in scenario (one of: ", 0),
             0u);
