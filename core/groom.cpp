@@ -17,16 +17,23 @@ void Groom::add_strand(std::span<const Vec3f> points, std::uint16_t region, int 
 }
 
 Groom every_nth_strand(const Groom& g, std::size_t keep_every) {
-  Groom thin;
-  thin.region_names = g.region_names;
-  thin.head_radius = g.head_radius;
-  for (std::size_t s = 0; s < g.strand_count(); s += std::max<std::size_t>(keep_every, 1)) {
+  std::vector<std::uint32_t> kept;
+  for (std::size_t s = 0; s < g.strand_count(); s += std::max<std::size_t>(keep_every, 1))
+    kept.push_back(static_cast<std::uint32_t>(s));
+  return select_strands(g, kept);
+}
+
+Groom select_strands(const Groom& g, std::span<const std::uint32_t> strands) {
+  Groom out;
+  out.region_names = g.region_names;
+  out.head_radius = g.head_radius;
+  for (const std::uint32_t s : strands) {
     const auto b = g.positions.begin() + g.strand_begin(s);
-    thin.positions.insert(thin.positions.end(), b, b + g.strand_size(s));
-    thin.strand_offsets.push_back(static_cast<std::uint32_t>(thin.positions.size()));
-    thin.strand_region.push_back(g.strand_region[s]);
+    out.positions.insert(out.positions.end(), b, b + g.strand_size(s));
+    out.strand_offsets.push_back(static_cast<std::uint32_t>(out.positions.size()));
+    out.strand_region.push_back(g.strand_region[s]);
   }
-  return thin;
+  return out;
 }
 
 std::vector<float> rest_edge_lengths(const Groom& g) {

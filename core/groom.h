@@ -4,6 +4,8 @@
 
 #include "core/types.h"
 
+#include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,6 +40,8 @@ double mean_strand_length(const Groom& g);
 // Every `keep_every`-th strand of g (strands 0, n, 2n, ...), with its region: a thinner
 // groom for tests and stress runs whose properties are per strand.
 Groom every_nth_strand(const Groom& g, std::size_t keep_every);
+// The given strands of g, in the order given, each with its region.
+Groom select_strands(const Groom& g, std::span<const std::uint32_t> strands);
 
 // Checks the invariants every model relies on and throws InputError naming `source` and
 // the first offending strand: >= 2 vertices, finite positions, no zero-length edge,

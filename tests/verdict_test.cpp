@@ -243,20 +243,12 @@ TEST(EnergySpread, CountsTheStrandsThatHoldNinetyPercent) {
 // edges of 5 and 7 mm; its median edge is 9.4 mm.
 Scenario ponytail_guides(std::uint32_t fold, std::uint32_t& fold_index) {
   Scenario sc = load_scenario(find_scenario("tressfx_ponytail_shake"));
-  const Groom& all = sc.guides;
-  Groom g;
-  g.region_names = all.region_names;
-  g.head_radius = all.head_radius;
-  g.strand_region.clear();
-  for (std::uint32_t s = 0; s < all.strand_count(); ++s) {
-    if (s % 97 != 0 && s != fold) continue;
-    if (s == fold) fold_index = static_cast<std::uint32_t>(g.strand_count());
-    g.positions.insert(g.positions.end(), all.positions.begin() + all.strand_begin(s),
-                       all.positions.begin() + all.strand_offsets[s + 1]);
-    g.strand_offsets.push_back(static_cast<std::uint32_t>(g.positions.size()));
-    g.strand_region.push_back(all.strand_region[s]);
+  std::vector<std::uint32_t> kept;
+  for (std::uint32_t s = 0; s < sc.guides.strand_count(); ++s) {
+    if (s == fold) fold_index = static_cast<std::uint32_t>(kept.size());
+    if (s % 97 == 0 || s == fold) kept.push_back(s);
   }
-  sc.groom = g;
+  sc.groom = select_strands(sc.guides, kept);
   sc.follow.reset();
   return sc;
 }

@@ -653,20 +653,13 @@ TEST(VulkanDeviceMetrics, RunnerStretched) {
 TEST(VulkanDeviceMetrics, SpreadNamesTheFlutteringGuideAsTheHostDoes) {
   HAIRBENCH_REQUIRE_VULKAN();
   Scenario sc = load_scenario(find_scenario("tressfx_ponytail_shake"));
-  Groom g;
-  g.region_names = sc.guides.region_names;
-  g.head_radius = sc.guides.head_radius;
-  g.strand_region.clear();
+  std::vector<std::uint32_t> kept;
   std::uint32_t fold = 0;
   for (std::uint32_t k = 0; k < sc.guides.strand_count(); ++k) {
-    if (k % 32 != 0 && k != 106) continue;
-    if (k == 106) fold = static_cast<std::uint32_t>(g.strand_count());
-    g.positions.insert(g.positions.end(), sc.guides.positions.begin() + sc.guides.strand_begin(k),
-                       sc.guides.positions.begin() + sc.guides.strand_offsets[k + 1]);
-    g.strand_offsets.push_back(static_cast<std::uint32_t>(g.positions.size()));
-    g.strand_region.push_back(sc.guides.strand_region[k]);
+    if (k == 106) fold = static_cast<std::uint32_t>(kept.size());
+    if (k % 32 == 0 || k == 106) kept.push_back(k);
   }
-  sc.guides = g;
+  sc.guides = select_strands(sc.guides, kept);
   sc.follow = tfx::make_follow_hairs(sc.guides, 4, 0.004, 5.0, 7);
   sc.groom = tfx::expand_follow_hairs(sc.guides, *sc.follow);
   ThreadPool pool(2);
