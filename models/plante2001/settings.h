@@ -21,7 +21,7 @@
 // under gravity (idle: 1.9% at most, next to the root). The bending springs derive from
 // an energy (see wisp_forces_and_velocities); their zigzag mode has omega^2 ~ 16 k, so
 // explicit integration at 1000 Hz holds up to k ~ 2.5e5 (measured on `idle` without
-// gravity: still at 2e5, the probe growing at 2.5e5, diverged at 4e5). 1e5 (omega h ~
+// gravity: `ok` at 2e5, the probe growing at 2.5e5 and 4e5). 1e5 (omega h ~
 // 1.3) is the stiffest default with that margin; it holds the style against metric
 // gravity far better than 5e3 (rest_shape_error on `idle` 0.049 L-bar against 0.12).
 // Nothing but bending holds the style (§3.2): the root of a horizontal wisp of length L

@@ -181,13 +181,13 @@ struct Skeleton {
 // edges, shared between stretches by length.
 //
 // The skeleton keeps its rest bends within kMaxRestBend at its free nodes and
-// kMaxAnchorBend at a pinned node next to a free segment: the bending springs' targets
-// turn with the section frames, which is not conservative (wisp_forces_and_velocities),
-// and a skeleton bent much more than that at a node flutters by itself at the default
-// stiffness (a curly groom's skeleton laid along its curls, or a strand folded over
-// within a segment on tressfx_ponytail_spin, kept moving at 0.5 m/s with the head
-// still); next to a pinned node the section frame bisects the head's segment and the
-// first free one, and turns over as they fold back onto each other. Where the mean curve
+// kMaxAnchorBend at a pinned node next to a free segment. A skeleton laid along a curly
+// groom's curls diverges at rest (PlanteWisp.CurlyGroomStaysOkAtRest without the
+// bounds): near a half turn the frames carried by minimal rotation turn over, and the
+// bending springs' twist loads grow as the curvature binormal, 2 tan(bend / 2)
+// (wisp_forces_and_velocities); next to a pinned node the section frame bisects the
+// head's segment and the first free one, and turns over as they fold back onto each
+// other. Where the mean curve
 // bends more at the nodes of the width's resolution, the skeleton is first made finer,
 // up to the strands' own edges (a fold of the style); where that is not enough, its
 // axis is the mean curve averaged over the shortest window, in whole mean edges, that

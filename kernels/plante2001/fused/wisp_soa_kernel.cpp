@@ -165,15 +165,14 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
                 const Eigen::Matrix3f& head_rot, const Vec3f& gravity, const Wind& wind, float h) {
   Block blk(s, wisps, count);
   const int n = blk.n;
-  V3 x[N], v[N], e1[N], e2[N], nn[N], bl[N], acc[N], seg_t[N];
-  float rest_len[N * W], free[N * W], r_rest[N * W], seg_len[N * W];
+  V3 x[N], v[N], e1[N], e2[N], bl[N], acc[N], seg_t[N], bishop_u[N], kappa[N];
+  float rest_len[N * W], free[N * W], r_rest[N * W], seg_len[N * W], seg_inv_len[N * W], twist_load[N * W];
   float seg_mass[N * W], inv_mass[N * W], bend_scale[N * W];
   float r[N * Q * W], rdot[N * Q * W], racc[N * Q * W];
   blk.load(x, s.x);
   blk.load(v, s.v);
   blk.load(e1, s.e1);
   blk.load(e2, s.e2);
-  blk.load(nn, s.n);
   blk.load(bl, s.bend_local);
   blk.load(rest_len, s.rest_len, 1);
   blk.load(seg_mass, s.seg_mass, 1);
@@ -201,14 +200,17 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       acc[i].set(l, a);
     }
   }
-  // Axial springs.
+  // Axial springs. Segment 0 (before the first node) has no length.
+  LANES seg_len[l] = seg_inv_len[l] = 0.0f;
   for (int i = 1; i < n; ++i) {
     LANES {
       const F3 d = sub(x[i].get(l), x[i - 1].get(l));
       const float len = std::sqrt(dot(d, d));
       seg_len[i * W + l] = len;
       bad[l] |= !(len > 0.0f);
-      const F3 t = quot(d, len);
+      const float inv_len = 1.0f / len;
+      seg_inv_len[i * W + l] = inv_len;
+      const F3 t = mul(inv_len, d);
       seg_t[i].set(l, t);
       const float f = seg_mass[i * W + l] * (p.axial_stiffness * (len - rest_len[i * W + l]) +
                                              p.axial_damping * dot(sub(v[i].get(l), v[i - 1].get(l)), t));
@@ -216,33 +218,90 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       acc[i].set(l, sub(acc[i].get(l), mul(f * inv_mass[i * W + l], t)));
     }
   }
-  // Bending springs.
+  // Bending springs (wisp_forces_and_velocities): the Bishop frames from the head-carried
+  // one of the first segment (Eigen's expressions per lane, as there), the springs, then
+  // their loads on the frames' twist, tip to root.
+  V3 root_t;
+  {
+    V3 u;
+    for (int l = 0; l < W; ++l) {
+      const std::uint32_t w = s.node_wisp[blk.base[l]];
+      const Vec3f rt = head_rot * s.root_t[w], ru = head_rot * s.rest_e1[w];
+      root_t.set(l, {rt.x(), rt.y(), rt.z()});
+      u.set(l, {ru.x(), ru.y(), ru.z()});
+    }
+    for (int i = 1; i < n; ++i) {
+      const V3& prev = i > 1 ? seg_t[i - 1] : root_t;
+      LANES {
+        const F3 t = seg_t[i].get(l), prev_t = prev.get(l), ul = u.get(l);
+        const float c = dot(prev_t, t);
+        bad[l] |= 1.0f + c < 1e-6f;
+        const F3 k_axis = cross(prev_t, t);
+        const F3 kap = mul(1.0f / (1.0f + c), k_axis);
+        kappa[i].set(l, kap);
+        const F3 turned = add(add(mul(c, ul), cross(k_axis, ul)), mul(dot(k_axis, ul), kap));
+        const F3 normal = sub(turned, mul(dot(turned, t), t));
+        const float n2 = dot(normal, normal);
+        bad[l] |= !(n2 > 1e-24f);
+        const F3 ui = mul(1.0f / std::sqrt(n2), normal);
+        u.set(l, ui);
+        bishop_u[i].set(l, ui);
+      }
+    }
+  }
+  for (int k = 0; k < n * W; ++k) twist_load[k] = 0.0f;
   float sin_angle[W], angle[W];
   F3 axis[W];
   for (int i = 2; i < n; ++i) {
     LANES {
-      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), u = bishop_u[i - 1].get(l);
       const F3 b = bl[i].get(l);
-      const F3 local = add(add(mul(b.x, e1[i - 2].get(l)), mul(b.y, e2[i - 2].get(l))), mul(b.z, nn[i - 2].get(l)));
-      const F3 target = minimal_rotate(nn[i - 2].get(l), t_prev, local, bad[l]);
-      axis[l] = cross(t, target);
+      const F3 target = add(add(mul(b.x, u), mul(b.y, cross(t_prev, u))), mul(b.z, t_prev));
+      axis[l] = cross(target, t);
       sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
       angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(target, t)) : 0.0f;
+      bl[i].set(l, target);  // the target from here on
     }
     LANES {
-      const float len = seg_len[i * W + l], len_prev = seg_len[(i - 1) * W + l];
-      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), target = bl[i].get(l);
       const bool bends = sin_angle[l] > 1e-7f;
-      const float torque = p.bending_stiffness * angle[l] * bend_scale[i * W + l];
-      const F3 a = quot(axis[l], sin_angle[l]);
+      const float q = p.bending_stiffness * angle[l] * bend_scale[i * W + l] / sin_angle[l];
       const F3 zero{0.0f, 0.0f, 0.0f};
-      const F3 fk = pick(bends, mul(torque / len, cross(a, t)), zero);
-      const F3 fk2 = pick(bends, mul(torque / len_prev, cross(a, t_prev)), zero);
+      const F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(target, mul(dot(target, t), t))), zero);
+      const F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], cross(t_prev, axis[l])), zero);
+      twist_load[(i - 1) * W + l] = bends ? -q * dot(t_prev, axis[l]) : 0.0f;
       const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
       const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
       acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
       acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
       acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
+    }
+  }
+  {
+    // Segment i's bend turns the frames of segments i.. : its load is the sum of theirs.
+    // Nodes i and i - 1 take the part through segment i, nodes i - 1 and i - 2 the part
+    // through segment i - 1 (none for i = 1: segment 0 is the head's).
+    float load[W];
+    LANES load[l] = 0.0f;
+    // A lane whose segment has no length is bad (the axial springs): the others need no
+    // test.
+    for (int i = n - 1; i > 1; --i) {
+      LANES {
+        load[l] += twist_load[i * W + l];
+        const F3 kap = kappa[i].get(l);
+        const F3 fn = mul(load[l] * seg_inv_len[i * W + l], kap);
+        const F3 fp = mul(load[l] * seg_inv_len[(i - 1) * W + l], kap);
+        acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], fn)));
+        const F3 ai1 = sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], fn));
+        acc[i - 1].set(l, add(ai1, mul(inv_mass[(i - 1) * W + l], fp)));
+        acc[i - 2].set(l, sub(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fp)));
+      }
+    }
+    LANES {
+      load[l] += twist_load[W + l];
+      const F3 fn = mul(load[l] * seg_inv_len[W + l], kappa[1].get(l));
+      acc[1].set(l, add(acc[1].get(l), mul(inv_mass[W + l], fn)));
+      acc[0].set(l, sub(acc[0].get(l), mul(inv_mass[l], fn)));
     }
   }
   // A wisp pinned at its tip as well: its last free segment's bending spring towards the

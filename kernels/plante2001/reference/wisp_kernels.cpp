@@ -34,6 +34,10 @@ void WispSystem::resize_state() {
   e2.assign(n, Vec3f::UnitY());
   this->n.assign(n, Vec3f::UnitZ());
   rest_e1.assign(wisp_count(), Vec3f::UnitX());
+  root_t.assign(wisp_count(), Vec3f::UnitY());
+  bishop_u.assign(n, Vec3f::UnitX());
+  bishop_kappa.assign(n, Vec3f::Zero());
+  twist_load.assign(n, 0.0f);
   rest_fe1.assign(n, Vec3f::UnitX());
   rest_fe2.assign(n, Vec3f::UnitY());
   frame_weight.assign(n, 1.0f);
@@ -52,6 +56,7 @@ void WispSystem::resize_state() {
   body_list.assign((kEnvelopePerSection + 1) * n, 0);
   body_list_size.assign((kEnvelopePerSection + 1) * wisp_count(), 0);
   seg_len.assign(n, 0.0f);
+  seg_inv_len.assign(n, 0.0f);
   seg_t.assign(n, Vec3f::Zero());
   node_dv.assign(n, Vec3f::Zero());
   node_dv_weight.assign(n, 0.0f);
@@ -174,6 +179,32 @@ void wisp_frames(WispSystem& s, std::size_t w, const Vec3f& root_e1) {
   }
 }
 
+void bishop_frames(WispSystem& s, std::size_t w, const Vec3f& root_t, const Vec3f& root_u) {
+  const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
+  Vec3f prev_t = root_t, u = root_u;
+  for (std::uint32_t k = b + 1; k < e; ++k) {
+    const Vec3f& t = s.seg_t[k];
+    // minimal_rotate, keeping the curvature binormal's half, (prev_t x t) / (1 + cos),
+    // for the twist loads; none where the segments fold back onto each other.
+    const float c = prev_t.dot(t);
+    Vec3f turned;
+    if (1.0f + c < 1e-6f) {
+      turned = minimal_rotate(prev_t, t, u);
+      s.bishop_kappa[k] = Vec3f::Zero();
+    } else {
+      const Vec3f k_axis = prev_t.cross(t);
+      const Vec3f kappa = (1.0f / (1.0f + c)) * k_axis;
+      turned = c * u + k_axis.cross(u) + k_axis.dot(u) * kappa;
+      s.bishop_kappa[k] = kappa;
+    }
+    const Vec3f normal = turned - turned.dot(t) * t;
+    const float n2 = normal.squaredNorm();
+    u = n2 > 1e-24f ? Vec3f((1.0f / std::sqrt(n2)) * normal) : t.unitOrthogonal();
+    s.bishop_u[k] = u;
+    prev_t = t;
+  }
+}
+
 void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
   for (std::uint32_t k = b; k < e; ++k) {
@@ -212,13 +243,17 @@ void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend) {
       if (s.pinned[j]) nearest = std::min(nearest, k > j ? k - j : j - k);
     s.frame_weight[k] = std::min(1.0f, static_cast<float>(nearest) / static_cast<float>(root_blend + 1));
   }
+  // The rest directions in the Bishop frames of the rest skeleton (bishop_frames): the
+  // frame of the first segment is rest_e1 about its own direction root_t.
+  s.root_t[w] = n0;
+  if (e - b < 3) return;
+  for (std::uint32_t k = b + 1; k < e; ++k) s.seg_t[k] = unit_or(s.rest_x[k] - s.rest_x[k - 1], n0);
+  bishop_frames(s, w, s.root_t[w], s.rest_e1[w]);
   for (std::uint32_t k = b + 2; k < e; ++k) {
-    // In the frame of segment (k-2, k-1): section frame k-2 turned so that its normal
-    // is that segment (see the bending springs in wisp_forces_and_velocities).
-    const Vec3f t = unit_or(s.rest_x[k] - s.rest_x[k - 1], s.n[k - 1]);
-    const Vec3f t_prev = unit_or(s.rest_x[k - 1] - s.rest_x[k - 2], s.n[k - 2]);
-    const Vec3f tl = minimal_rotate(t_prev, s.n[k - 2], t);
-    s.bend_local[k] = Vec3f(tl.dot(s.e1[k - 2]), tl.dot(s.e2[k - 2]), tl.dot(s.n[k - 2]));
+    const Vec3f& u = s.bishop_u[k - 1];
+    const Vec3f& tp = s.seg_t[k - 1];
+    const Vec3f& t = s.seg_t[k];
+    s.bend_local[k] = Vec3f(t.dot(u), t.dot(tp.cross(u)), t.dot(tp));
   }
 }
 
@@ -253,52 +288,79 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     const float len = d.norm();
     s.seg_len[k] = len;
     if (!(len > 0.0f)) continue;
-    const Vec3f t = d / len;
+    const float inv_len = 1.0f / len;
+    s.seg_inv_len[k] = inv_len;
+    const Vec3f t = inv_len * d;
     s.seg_t[k] = t;
     const float f =
         s.seg_mass[k] * (p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t));
     s.acc[k - 1] += (f * s.inv_mass[k - 1]) * t;
     s.acc[k] -= (f * s.inv_mass[k]) * t;
   }
-  // Damped bending springs whose force grows linearly with the bending angle (§3.2):
-  // segment (k-1, k) is turned towards its rest direction relative to segment
-  // (k-2, k-1), read in section frame k-2 (propagated without twist from the head,
-  // §3.3) turned so that its normal is that segment: the rest style is the target.
-  // The spring is a torque k * angle * bend_scale at node k-1 (bend_scale = L0^2 m, L0
-  // and m the shorter rest length and lighter hair of the two segments, so that the
-  // lateral acceleration it puts on nodes k and k-2, torque / length^2 / mass, stays at
-  // most about k whatever their ratio: with the longer one, TressFX's curls of 2 mm
-  // segments next to 5 mm ones flew apart; wisp_init_rest) acting on segment (k-1, k)
-  // and, in reverse, on segment (k-2, k-1): forces on nodes k and k-2, their negated sum
-  // on k-1, so that it neither pushes nor spins the wisp as a whole. The target turns
-  // with the whole of segment (k-2, k-1), which takes the reaction, and the torque does
-  // not grow with stretch, so the spring derives from the energy k bend_scale angle^2 / 2
-  // (up to the frame's twist about the segment): read in the bisecting section frame
-  // itself, the target turned with only half of that segment and half of the one
-  // before, which takes no reaction - a follower load whose flutter grows from rounding
-  // on a still head without gravity above k ~ 1e4 at 1000 Hz.
+  // Damped bending springs whose force grows linearly with the bending angle (§3.2),
+  // towards the rest style: segment (k-1, k) is turned towards its rest direction in the
+  // Bishop frame of segment (k-2, k-1) (bishop_frames: the head-carried frame of the
+  // first segment, carried segment to segment by minimal rotation, §3.3's "quaternion
+  // that minimally rotates"), with the energy k bend_scale angle^2 / 2 (bend_scale = L0^2
+  // m, L0 and m the shorter rest length and lighter hair of the two segments: the lateral
+  // acceleration on nodes k and k-2, torque / length^2 / mass, stays at most about k
+  // whatever their ratio; wisp_init_rest). The forces are that energy's exact negative
+  // gradient, so the springs neither pump energy nor push the wisp as a whole:
+  //  - through segment (k-1, k), on nodes k and k-1;
+  //  - through segment (k-2, k-1), which carries the frame, on nodes k-1 and k-2;
+  //  - through the frame's twist about segment (k-2, k-1), which every bend between the
+  //    head and that segment sets (the frames' holonomy). A bend between segments e_prev
+  //    and e, kappa_b = 2 t_prev x t / (1 + t_prev . t) its curvature binormal, adds to
+  //    the twist of the frames after it kappa_b . dx / (2 |e_prev|) for a move dx of
+  //    e_prev's first node, -kappa_b . dx / (2 |e|) for one of e's last node, and minus
+  //    their sum for the node between: the holonomy gradient of discrete elastic rods
+  //    (Bergou et al. 2008). The springs' loads on the twist (twist_load) are summed tip
+  //    to root and applied per node in one pass.
+  // Without the twist's part (a target that turns only with segment (k-2, k-1)) the
+  // springs are a follower load, which a fold of the style turns into flutter with the
+  // head still: a ponytail guide folded 110 degrees over a 2 mm segment, resampled to 32
+  // vertices (tests/plante_test.cpp).
+  bishop_frames(s, w, head_rot * s.root_t[w], head_rot * s.rest_e1[w]);
+  for (std::uint32_t k = b + 1; k < e; ++k) s.twist_load[k] = 0.0f;
   for (std::uint32_t k = b + 2; k < e; ++k) {
     const float len = s.seg_len[k], len_prev = s.seg_len[k - 1];
     if (!(len > 0.0f) || !(len_prev > 0.0f)) continue;
     const Vec3f& t = s.seg_t[k];
     const Vec3f& t_prev = s.seg_t[k - 1];
+    const Vec3f& u = s.bishop_u[k - 1];
     const Vec3f& bl = s.bend_local[k];
-    const Vec3f target =
-        minimal_rotate(s.n[k - 2], t_prev, bl.x() * s.e1[k - 2] + bl.y() * s.e2[k - 2] + bl.z() * s.n[k - 2]);
-    const Vec3f axis = t.cross(target);
+    const Vec3f target = bl.x() * u + bl.y() * t_prev.cross(u) + bl.z() * t_prev;
+    const Vec3f axis = target.cross(t);
     const float sin_angle = axis.norm();
     Vec3f fk = Vec3f::Zero(), fk2 = Vec3f::Zero();
     if (sin_angle > 1e-7f) {
-      const float torque = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * s.bend_scale[k];
-      const Vec3f a = axis / sin_angle;
-      fk = (torque / len) * a.cross(t);
-      fk2 = (torque / len_prev) * a.cross(t_prev);
+      // q = dE/d(angle) / sin(angle): the gradient of cos(angle) = t . target, times q.
+      const float q = p.bending_stiffness * atan2_upper(sin_angle, target.dot(t)) * s.bend_scale[k] / sin_angle;
+      fk = (q * s.seg_inv_len[k]) * (target - target.dot(t) * t);
+      fk2 = (q * s.seg_inv_len[k - 1]) * (t_prev.cross(axis));
+      s.twist_load[k - 1] = -q * t_prev.dot(axis);
     }
     const Vec3f dv = s.v[k] - s.v[k - 1];
     const Vec3f damp = (p.bending_damping * s.seg_mass[k]) * (dv - dv.dot(t) * t);
     s.acc[k] += (fk - damp) * s.inv_mass[k];
     s.acc[k - 2] += fk2 * s.inv_mass[k - 2];
     s.acc[k - 1] -= (fk + fk2 - damp) * s.inv_mass[k - 1];
+  }
+  float load = 0.0f;
+  for (std::uint32_t k = e - 1; k > b; --k) {
+    load += s.twist_load[k];
+    if (!(s.seg_len[k] > 0.0f)) continue;
+    // kappa_b / 2 of the bend between segments k - 1 (the head's direction for the first)
+    // and k.
+    const Vec3f& kappa = s.bishop_kappa[k];
+    const Vec3f fn = (load * s.seg_inv_len[k]) * kappa;
+    s.acc[k] += fn * s.inv_mass[k];
+    s.acc[k - 1] -= fn * s.inv_mass[k - 1];
+    if (k > b + 1 && s.seg_len[k - 1] > 0.0f) {
+      const Vec3f fp = (load * s.seg_inv_len[k - 1]) * kappa;
+      s.acc[k - 1] += fp * s.inv_mass[k - 1];
+      s.acc[k - 2] -= fp * s.inv_mass[k - 2];
+    }
   }
   // A wisp pinned at its tip as well (TressFX strands pinned at both ends) ends in a
   // single pinned node, not in a pinned segment as at the root (§3.2): nothing else holds
@@ -312,7 +374,7 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
     const Vec3f d = s.x[e - 1] - s.x[k];
     const float len = d.norm();
     if (len > 0.0f) {
-      const Vec3f t = d / len;
+      const Vec3f t = (1.0f / len) * d;  // as seg_t, which the block kernel reads
       const Vec3f target = head_rot * (s.rest_x[e - 1] - s.rest_x[k]).normalized();
       const Vec3f axis = t.cross(target);
       const float sin_angle = axis.norm();

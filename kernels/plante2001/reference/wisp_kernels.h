@@ -84,7 +84,15 @@ struct WispSystem {
   // where (k-2, k-1) is the head's (wisp_init_rest).
   std::vector<float> bend_scale;
   std::vector<float> rest_len;    // segment (k-1, k), stored at k (0 at a wisp's first node)
-  std::vector<Vec3f> bend_local;  // rest direction of segment (k-1, k) in frame k-2 turned onto segment (k-2, k-1)
+  // Rest direction of segment (k-1, k), stored at k, in the Bishop frame (u, t x u, t) of
+  // segment (k-2, k-1) (bishop_frames).
+  std::vector<Vec3f> bend_local;
+  std::vector<Vec3f> root_t;      // per wisp: rest direction of its first segment, head rest frame
+  // Scratch of wisp_forces_and_velocities: the Bishop frames' u of segment (k-1, k) at k,
+  // half the curvature binormal of the bend between segments k-1 and k, (t_{k-1} x t_k) /
+  // (1 + t_{k-1} . t_k), and the bending springs' loads on the twist of those frames.
+  std::vector<Vec3f> bishop_u, bishop_kappa;
+  std::vector<float> twist_load;
   // Section frames (§3.3): e1, e2 span the plane bisecting the adjacent segments, n its
   // normal; propagated root to tip by minimal rotation from the head-attached root frame.
   std::vector<Vec3f> e1, e2, n;
@@ -109,8 +117,9 @@ struct WispSystem {
   // between detections: wisp w's from body_list[5 node_begin[w]], in 5 slots (the
   // skeleton masses, then the envelope masses q = 0..3) of body_list_size[5 w + slot].
   std::vector<std::uint32_t> body_list, body_list_size;
-  // Scratch of wisp_forces_and_velocities: length and direction of segment (k-1, k) at k.
-  std::vector<float> seg_len;
+  // Scratch of wisp_forces_and_velocities: length, its inverse and direction of segment
+  // (k-1, k) at k.
+  std::vector<float> seg_len, seg_inv_len;
   std::vector<Vec3f> seg_t;
   // Per-mass velocity modification accumulators for the wisp-wisp response.
   std::vector<Vec3f> node_dv;
@@ -183,6 +192,14 @@ SectionFrame section_frame(const WispSystem& s, std::uint32_t k, float sfrac, co
 
 // Rotates v by the minimal rotation taking unit a to unit b (no twist about the axis).
 Vec3f minimal_rotate(const Vec3f& a, const Vec3f& b, const Vec3f& v);
+
+// Bishop frames of wisp w's segments from the unit directions seg_t (at k for segment
+// (k-1, k)): a unit vector u normal to each, carried from `root_u` (normal to `root_t`,
+// the head-carried rest direction of the first segment) segment to segment by the minimal
+// rotation between their directions (no twist about them), into bishop_u, and half of each
+// bend's curvature binormal into bishop_kappa. The bending springs read their rest
+// directions in these frames.
+void bishop_frames(WispSystem& s, std::size_t w, const Vec3f& root_t, const Vec3f& root_u);
 
 // Section frames of wisp w from its skeleton: n_k bisects the adjacent segments, e1 of
 // the first section is `root_e1` (head-attached), every other frame is the previous one
