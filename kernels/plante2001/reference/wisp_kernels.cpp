@@ -371,10 +371,9 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
   // segment: towards its head-carried rest direction, the head taking the reaction.
   if (e - b >= 3 && s.pinned[e - 1] && !s.pinned[e - 2]) {
     const std::uint32_t k = e - 2;
-    const Vec3f d = s.x[e - 1] - s.x[k];
-    const float len = d.norm();
+    const float len = s.seg_len[e - 1];
     if (len > 0.0f) {
-      const Vec3f t = (1.0f / len) * d;  // as seg_t, which the block kernel reads
+      const Vec3f& t = s.seg_t[e - 1];
       const Vec3f target = head_rot * (s.rest_x[e - 1] - s.rest_x[k]).normalized();
       const Vec3f axis = t.cross(target);
       const float sin_angle = axis.norm();
