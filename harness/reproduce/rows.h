@@ -6,8 +6,9 @@
 //   claim        a property the paper asserts, tested in a form that survives a change of
 //                hardware: holds, differs (with a reason built from measured numbers), or
 //                not testable here (with the reason).
-//   measurement  a number that depends on the machine or on the 2001/2007/2012 code (a
-//                time, a time share), shown beside the paper's, with no verdict.
+//   measurement  a number that depends on the machine, on the 2001/2007/2012 code or on
+//                the paper's grooms (a time, a time share, a count the wisps' spacing
+//                sets), shown beside the paper's, with no verdict.
 //
 // Every verdict follows from the row's own JSON fields, so a reader can recompute it.
 #pragma once
