@@ -124,7 +124,7 @@ TEST(Reproduce, QuickRunOfEveryPaperWritesTheThreeKindsOfRows) {
 
   const nlohmann::json rep = nlohmann::json::parse(slurp(out / "reproduce.json"));
   EXPECT_EQ(rep["schema"], "hairbench-reproduce");
-  EXPECT_EQ(rep["schema_version"], 2);
+  EXPECT_EQ(rep["schema_version"], 3);
   EXPECT_EQ(rep["frames_cap"], 2);
   ASSERT_EQ(rep["papers"].size(), 3u);
   int matches = 0, mismatches = 0, holds = 0, differs = 0, untestable = 0, measurements = 0;

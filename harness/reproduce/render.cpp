@@ -33,6 +33,26 @@ std::string values(const json& v) {
   return s;
 }
 
+// A claim's published or measured cell: its plain numbers first (the absolute values a
+// reader compares with the paper's), then the tested quantity the verdict reads.
+std::string claim_value(const json& c, const char* which) {
+  const std::string tested = jnum_str(c[which]);
+  if (!c.contains("numbers") || c["numbers"].empty()) return tested;
+  std::string s;
+  for (const json& n : c["numbers"]) s += (s.empty() ? "" : ", ") + n["label"].get<std::string>() + " " + jnum_str(n[which]);
+  return s + "; tested " + tested;
+}
+
+// The same numbers as one line of the claim's details ("" when it has none).
+std::string numbers_line(const json& c) {
+  if (!c.contains("numbers") || c["numbers"].empty()) return "";
+  std::string s;
+  for (const json& n : c["numbers"])
+    s += (s.empty() ? "" : ", ") + n["label"].get<std::string>() + " " + jnum_str(n["measured"]) + " (published " +
+         jnum_str(n["published"]) + ")";
+  return s;
+}
+
 std::string joined(const json& v) {
   std::string s;
   for (const json& x : v) s += (s.empty() ? "" : ", ") + x.get<std::string>();
@@ -117,7 +137,8 @@ std::string reproduce_markdown(const json& r) {
     for (const json& c : p["claims"])
       o << "| " << p["id"].get<std::string>() << " | " << c["id"].get<std::string>() << " | "
         << md_cell(c["source"]["quote"].get<std::string>() + " (" + c["source"]["where"].get<std::string>() + ")")
-        << " | " << md_cell(c["quantity"]) << " | " << jnum_str(c["published"]) << " | " << jnum_str(c["measured"])
+        << " | " << md_cell(c["quantity"]) << " | " << md_cell(claim_value(c, "published")) << " | "
+        << md_cell(claim_value(c, "measured"))
         << " | " << bounds(c) << " | " << c["verdict"].get<std::string>() << " | " << md_cell(c["reason"]) << " |\n";
   o << "\n## Setup\n\n| paper | setup | the paper | this run | verdict |\n|---|---|---|---|---|\n";
   for (const json& p : r["papers"])
@@ -137,8 +158,9 @@ std::string reproduce_markdown(const json& r) {
     o << "\n### " << p["id"].get<std::string>() << ": " << p["paper"].get<std::string>() << "\n";
     for (const json& c : p["claims"]) {
       o << "\n#### " << c["id"].get<std::string>() << ": " << c["verdict"].get<std::string>() << "\n\n> "
-        << c["source"]["quote"].get<std::string>() << " (" << c["source"]["where"].get<std::string>() << ")\n\n"
-        << "- settings: " << c["settings"].get<std::string>() << "\n- quantity: " << c["quantity"].get<std::string>()
+        << c["source"]["quote"].get<std::string>() << " (" << c["source"]["where"].get<std::string>() << ")\n\n";
+      if (const std::string n = numbers_line(c); !n.empty()) o << "- beside the paper's: " << n << "\n";
+      o << "- settings: " << c["settings"].get<std::string>() << "\n- quantity: " << c["quantity"].get<std::string>()
         << " = " << jnum_str(c["measured"]) << " (published " << jnum_str(c["published"]) << "; holds if "
         << bounds(c) << ")\n- why these bounds: " << c["threshold_why"].get<std::string>() << "\n- measured: "
         << c["detail"].get<std::string>() << "\n";
@@ -180,8 +202,8 @@ std::string reproduce_html(const json& r, const std::filesystem::path& charts_di
     for (const json& c : p["claims"])
       o << "<tr><td>" << e(p["id"]) << "</td><td><a href=\"#" << e(p["id"]) << "_" << e(c["id"]) << "\">" << e(c["id"])
         << "</a></td><td>" << e(c["source"]["quote"]) << " (" << e(c["source"]["where"]) << ")</td><td>"
-        << e(c["quantity"]) << "</td><td>" << es(jnum_str(c["published"])) << "</td><td>"
-        << es(jnum_str(c["measured"])) << "</td><td>" << es(bounds(c)) << "</td>" << verdict(c) << "<td>"
+        << e(c["quantity"]) << "</td><td>" << es(claim_value(c, "published")) << "</td><td>"
+        << es(claim_value(c, "measured")) << "</td><td>" << es(bounds(c)) << "</td>" << verdict(c) << "<td>"
         << e(c["reason"]) << "</td></tr>\n";
   o << "</table>\n<h2>Setup</h2>\n<p class=\"note\">Whether the runs are the papers' configuration; never counted "
        "as a claim.</p>\n<table><tr><th>paper</th><th>setup</th><th>the paper</th><th>this run</th><th>verdict</th>"
@@ -203,8 +225,9 @@ std::string reproduce_html(const json& r, const std::filesystem::path& charts_di
     o << "<h2>" << e(p["id"]) << ": " << e(p["paper"]) << "</h2>\n";
     for (const json& c : p["claims"]) {
       o << "<h3 id=\"" << e(p["id"]) << "_" << e(c["id"]) << "\">" << e(c["id"]) << ": " << e(c["verdict"])
-        << "</h3>\n<blockquote>" << e(c["source"]["quote"]) << " (" << e(c["source"]["where"]) << ")</blockquote>\n<ul>"
-        << "<li>settings: " << e(c["settings"]) << "</li><li>quantity: " << e(c["quantity"]) << " = "
+        << "</h3>\n<blockquote>" << e(c["source"]["quote"]) << " (" << e(c["source"]["where"]) << ")</blockquote>\n<ul>";
+      if (const std::string n = numbers_line(c); !n.empty()) o << "<li>beside the paper's: " << es(n) << "</li>";
+      o << "<li>settings: " << e(c["settings"]) << "</li><li>quantity: " << e(c["quantity"]) << " = "
         << es(jnum_str(c["measured"])) << " (published " << es(jnum_str(c["published"])) << "; holds if "
         << es(bounds(c)) << ")</li><li>why these bounds: " << e(c["threshold_why"]) << "</li><li>measured: "
         << e(c["detail"]) << "</li>";

@@ -65,7 +65,7 @@ json run_reproduce(const ReproduceOptions& opt, const std::function<void(const s
   const auto start = std::chrono::steady_clock::now();
   ThreadPool pool(opt.threads);
   const reproduce::Ctx c{opt, pool, log};
-  json report = {{"schema", "hairbench-reproduce"}, {"schema_version", 2}};
+  json report = {{"schema", "hairbench-reproduce"}, {"schema_version", 3}};
   report["context"] = make_report(ReportContext{pool.threads(), {}}, {})["context"];
   const json load_start = load_average();
   json papers = json::array();

@@ -75,10 +75,16 @@ json to_json(const ClaimRow& r) {
              {"x", jnums(r.chart->x)},   {"series", series},          {"log_x", r.chart->log_x},
              {"log_y", r.chart->log_y}};
   }
+  json numbers = json::array();
+  for (const Number& n : r.numbers)
+    numbers.push_back({{"label", n.label},
+                       {"published", n.published ? jnum(*n.published) : json(nullptr)},
+                       {"measured", jnum(n.measured)}});
   return {{"kind", "claim"},
           {"id", r.id},
           {"source", source_json(r.source)},
           {"settings", r.settings},
+          {"numbers", numbers},
           {"quantity", r.quantity},
           {"published", r.published ? jnum(*r.published) : json(nullptr)},
           {"measured", r.not_testable ? json(nullptr) : jnum(r.measured)},

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,6 +53,14 @@ struct Chart {
   bool log_x = false, log_y = false;
 };
 
+// A plain number a reader compares with the paper's first (an absolute speed-up whose
+// ratio the claim tests, say): shown before the claim's quantity, never read by the verdict.
+struct Number {
+  std::string label{};
+  std::optional<double> published{};
+  double measured = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct ClaimRow {
   std::string id{};
   Source source{};
@@ -60,6 +69,7 @@ struct ClaimRow {
   std::optional<double> published{};  // the paper's value of the quantity, when it has one
   double measured = 0.0;
   std::optional<double> min{}, max{};  // holds when measured is finite and within these
+  std::vector<Number> numbers{};       // shown first, beside the paper's; not the verdict's
   std::string threshold_why{};         // why these bounds: what makes the claim true
   std::string detail{};                // the measured values the quantity comes from
   // Set only when the claim cannot be tested here; then `measured` and the bounds are
