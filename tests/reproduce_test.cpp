@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -53,6 +54,54 @@ void expect_claim_verdict_follows(const nlohmann::json& c) {
                      (hi.is_null() || c["measured"].get<double>() <= hi.get<double>());
   EXPECT_EQ(c["verdict"], holds ? "holds" : "differs");
   EXPECT_EQ(reason.empty(), holds) << "a reason exactly when it differs";
+}
+
+// A claim's plain numbers (each with a label and the paper's value) lead its cells in the
+// Markdown claims table, before the tested quantity; m3_5_to_29x's are each model's M1/M3
+// beside Table 2's, in whole sets of the three models.
+void expect_numbers_shown_first(const nlohmann::json& paper, const nlohmann::json& c, const std::string& md) {
+  SCOPED_TRACE(c["id"].get<std::string>());
+  ASSERT_TRUE(c["numbers"].is_array());
+  for (const auto& n : c["numbers"]) EXPECT_FALSE(n["label"].get<std::string>().empty());
+  if (c["id"] == "m3_5_to_29x") {
+    const nlohmann::json pub = rp::load_published("han2012");
+    std::map<std::string, double> m1, m3;
+    for (const auto& row : pub["tables"]["table2"]["rows"])
+      (row[1] == "m1" ? m1 : m3)[row[0].get<std::string>()] = row[4].get<double>();
+    ASSERT_FALSE(c["numbers"].empty()) << "the absolute M1/M3 beside the paper's";
+    ASSERT_EQ(c["numbers"].size() % 3, 0u);
+    for (std::size_t i = 0; i < c["numbers"].size(); ++i) {
+      const std::string model = "model" + std::to_string(i % 3 + 1);
+      EXPECT_EQ(c["numbers"][i]["label"].get<std::string>().rfind(model, 0), 0u) << c["numbers"][i];
+      EXPECT_NEAR(c["numbers"][i]["published"].get<double>(), m1[model] / m3[model], 1e-12);
+    }
+  }
+  if (c["numbers"].empty()) return;
+  const std::string head = "| " + paper["id"].get<std::string>() + " | " + c["id"].get<std::string>() + " |";
+  const std::size_t row = md.find(head);
+  ASSERT_NE(row, std::string::npos);
+  const std::string line = md.substr(row, md.find('\n', row) - row);
+  const std::size_t first = line.find(c["numbers"][0]["label"].get<std::string>());
+  EXPECT_NE(first, std::string::npos) << line;
+  EXPECT_LT(first, line.find("; tested ")) << line;
+}
+
+// m2_as_smooth_with_iterations reads its chart: the largest ratio of a model's deviation
+// at one iteration count to the one before (a model's counts are its non-null points).
+void expect_steps_give_the_measured(const nlohmann::json& c) {
+  ASSERT_FALSE(c["chart"].is_null());
+  double worst = -std::numeric_limits<double>::infinity();
+  for (const auto& s : c["chart"]["series"]) {
+    double prev = std::numeric_limits<double>::quiet_NaN();
+    int points = 0;
+    for (const auto& y : s["y"]) {
+      if (!y.is_number()) continue;
+      if (points++ > 0) worst = std::max(worst, y.get<double>() / prev);
+      prev = y.get<double>();
+    }
+    EXPECT_EQ(points, 4) << s["label"] << ": Table 2's count, 8, 32, 128";
+  }
+  EXPECT_NEAR(c["measured"].get<double>(), worst, 1e-9 * worst);
 }
 
 TEST(Reproduce, BadArgumentsExitTwo) {
@@ -133,7 +182,8 @@ TEST(Reproduce, QuickRunOfEveryPaperWritesTheThreeKindsOfRows) {
   for (const auto& paper : rep["papers"]) {
     SCOPED_TRACE(paper["id"].get<std::string>());
     EXPECT_FALSE(paper["setups"].empty());
-    EXPECT_FALSE(paper["claims"].empty());
+    // A paper may have no claim row: Plante et al.'s §5.3 numbers are set by their grooms
+    // and machine, so they are measurements.
     EXPECT_FALSE(paper["measurements"].empty());
     for (const auto& s : paper["setups"]) {
       EXPECT_EQ(s["kind"], "setup");
@@ -149,6 +199,8 @@ TEST(Reproduce, QuickRunOfEveryPaperWritesTheThreeKindsOfRows) {
       (v == "holds" ? holds : v == "differs" ? differs : untestable)++;
       EXPECT_NE(md.find(c["source"]["quote"].get<std::string>()), std::string::npos) << "the paper's sentence";
       EXPECT_NE(html.find(c["id"].get<std::string>()), std::string::npos) << c["id"];
+      expect_numbers_shown_first(paper, c, md);
+      if (c["id"] == "m2_as_smooth_with_iterations") expect_steps_give_the_measured(c);
       if (!c["chart"].is_null()) {
         EXPECT_TRUE(std::filesystem::exists(out / "charts" /
                                             (paper["id"].get<std::string>() + "_" + c["id"].get<std::string>() + ".png")))
@@ -164,6 +216,7 @@ TEST(Reproduce, QuickRunOfEveryPaperWritesTheThreeKindsOfRows) {
       ++measurements;
     }
   }
+  EXPECT_GT(holds + differs + untestable, 0);
   EXPECT_EQ(rep["summary"]["setup"]["matches"], matches);
   EXPECT_EQ(rep["summary"]["setup"]["mismatches"], mismatches);
   EXPECT_EQ(rep["summary"]["claims"]["holds"], holds);
