@@ -431,7 +431,7 @@ PaperResult reproduce_han(const Ctx& c) {
                         num(m.jag.at({"m3", n0})) + ")";
                });
     k.why_differs = "method 2 does not come closer to method 1 at every increase of N: " + rising;
-    k.chart = Chart{"method 2's deviation from method 1 at equal local iterations", "local iterations N",
+    k.chart = Chart{"M2's deviation from M1 at equal iterations", "local iterations N",
                     "RMS deviation M2 - M1 (of strand length)", {}, {}, true, true};
     // The x axis is the union of the models' counts (Table 2's differ by model).
     std::vector<int> xs;
