@@ -95,6 +95,17 @@ INSTANTIATE_TEST_SUITE_P(Registry, FusedAgainstReference,
                                   std::get<1>(p.param).name;
                          });
 
+// plante_wisp's block lanes with the paper's bending law (§3.2, `bending` 0: springs on
+// the bend angles, no Bishop frames) against plante_wisp_ref's per-wisp kernel
+// (kernels::paper_bending), bit for bit through the whole shake: the scene cases above
+// run the default law only.
+TEST(FusedAgainstReference, PlanteWispWithThePapersBendingLaw) {
+  const Scenario sc = test::builtin("shake", 8);
+  double diff = 0.0;
+  EXPECT_EQ(test::first_difference(sc, "plante_wisp", "plante_wisp_ref", sc.frames, {{"*", "bending", 0}}, &diff), -1)
+      << "largest coordinate difference " << diff;
+}
+
 // Every fast model the registry lists has a reference, and every reference names a model
 // that exists: a new fast path cannot skip the agreement above.
 TEST(FusedAgainstReference, EveryCpuModelHasAReference) {

@@ -463,19 +463,12 @@ TEST(PlanteWisp, FineGroomsStandWithTheHeadStill) {
   }
 }
 
-// The bending springs (§3.2) derive from an energy: k bend_scale angle^2 / 2 at each
-// node, the angle between a segment and its rest direction read in the Bishop frame of
-// the segment before it, carried from the head without twist. Their forces are that
-// energy's negative gradient, the change of the frames' twist included: checked by
-// central differences on a folded, twisted wisp (a 110-degree fold after a 2.7 mm segment)
-// bent away from its rest shape. A target turned with a frame that takes no reaction is
-// not a gradient, and on such a fold it pumps energy into a wisp that should rest.
-TEST(PlanteWisp, BendingForcesAreTheNegativeGradientOfTheBendingEnergy) {
+// A wisp of one strand with the rest skeleton `rest` (nodes 0 and 1 pinned, unit hair per
+// segment), its free nodes moved by `bend` times a fixed pattern of offsets.
+kernels::WispSystem hand_wisp(const std::vector<Vec3f>& rest, float bend) {
   namespace k = kernels;
   k::WispSystem s;
-  s.rest_x = {{0.0f, 0.0f, 0.0f},         {0.0f, 0.010f, 0.0f},      {0.001f, 0.018f, 0.002f},
-              {0.002f, 0.020f, 0.0005f},  {0.0025f, 0.014f, -0.003f}, {0.006f, 0.006f, -0.004f},
-              {0.010f, 0.0f, -0.002f},    {0.012f, -0.008f, 0.003f}};
+  s.rest_x = rest;
   const std::uint32_t n = static_cast<std::uint32_t>(s.rest_x.size());
   s.node_begin = {0, n};
   s.wisp_params = {0};
@@ -487,14 +480,87 @@ TEST(PlanteWisp, BendingForcesAreTheNegativeGradientOfTheBendingEnergy) {
   s.resize_state();
   k::wisp_init_rest(s, 0, 3);
   for (std::uint32_t i = 2; i < n; ++i)
-    s.x[i] = s.rest_x[i] + 0.002f * Vec3f(std::sin(1.0f * i), std::cos(2.0f * i), std::sin(3.0f * i));
+    s.x[i] = s.rest_x[i] + bend * Vec3f(std::sin(1.0f * i), std::cos(2.0f * i), std::sin(3.0f * i));
   k::wisp_frames(s, 0, s.rest_e1[0]);
-  // Bending alone: no gravity, drag, axial, envelope or damping forces.
-  k::WispParams p;
+  return s;
+}
+
+// The wisp's bending forces under `law` (no gravity, drag, axial, envelope or damping
+// forces, head at rest): the production kernel's accelerations times the masses.
+std::vector<Vec3f> bending_forces(kernels::WispSystem s, kernels::BendingLaw law) {
+  kernels::WispParams p;
   p.air_drag = p.axial_stiffness = p.axial_damping = p.bending_damping = 0.0f;
   p.radial_stiffness = p.radial_damping = p.ring_stiffness = p.ring_damping = 0.0f;
-  k::wisp_forces_and_velocities(s, 0, p, Eigen::Matrix3f::Identity(), Vec3f::Zero(), Wind{}, 1.0f);
+  p.bending = law;
+  kernels::wisp_forces_and_velocities(s, 0, p, Eigen::Matrix3f::Identity(), Vec3f::Zero(), Wind{}, 1.0f);
+  std::vector<Vec3f> f(s.node_count());
+  for (std::size_t i = 0; i < f.size(); ++i) f[i] = s.acc[i] * s.mass[i];
+  return f;
+}
 
+// The largest force component on the free nodes, and the largest difference between two
+// sets of forces there.
+double largest_free(const kernels::WispSystem& s, const std::vector<Vec3f>& f) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (!s.pinned[i]) m = std::max(m, double(f[i].cwiseAbs().maxCoeff()));
+  return m;
+}
+double largest_difference(const kernels::WispSystem& s, const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+  std::vector<Vec3f> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = a[i] - b[i];
+  return largest_free(s, d);
+}
+
+// The forces `law`'s kernel puts on wisp s against central differences of `energy` (of
+// the node positions) on its free nodes: the largest force, and the largest |force +
+// gradient|.
+template <class Energy>
+std::pair<double, double> gradient_check(const kernels::WispSystem& s, kernels::BendingLaw law, Energy&& energy) {
+  const std::vector<Vec3f> f = bending_forces(s, law);
+  double largest = 0.0, worst = 0.0;
+  const float step = 1e-5f;
+  for (std::uint32_t i = 2; i < s.node_count(); ++i)
+    for (int d = 0; d < 3; ++d) {
+      std::vector<Vec3f> plus = s.x, minus = s.x;
+      plus[i][d] += step;
+      minus[i][d] -= step;
+      const double gradient = (energy(plus) - energy(minus)) / (double(plus[i][d]) - double(minus[i][d]));
+      largest = std::max(largest, std::abs(double(f[i][d])));
+      worst = std::max(worst, std::abs(double(f[i][d]) + gradient));
+    }
+  return {largest, worst};
+}
+
+// A folded, twisted wisp: a 110-degree fold after a 2.7 mm segment.
+const std::vector<Vec3f> kFoldedWisp = {
+    {0.0f, 0.0f, 0.0f},        {0.0f, 0.010f, 0.0f},       {0.001f, 0.018f, 0.002f}, {0.002f, 0.020f, 0.0005f},
+    {0.0025f, 0.014f, -0.003f}, {0.006f, 0.006f, -0.004f}, {0.010f, 0.0f, -0.002f},  {0.012f, -0.008f, 0.003f}};
+
+// A planar arc in the xy plane: the pinned head segment along +y, then 1 cm segments
+// each turning by `turn` radians about +z.
+std::vector<Vec3f> planar_arc(float turn, int free_segments) {
+  std::vector<Vec3f> x = {Vec3f::Zero(), Vec3f(0.0f, 0.01f, 0.0f)};
+  float heading = 0.0f;
+  for (int i = 0; i < free_segments; ++i) {
+    heading += turn;
+    x.push_back(x.back() + 0.01f * Vec3f(-std::sin(heading), std::cos(heading), 0.0f));
+  }
+  return x;
+}
+
+// The bending springs (§3.2) derive from an energy: k bend_scale angle^2 / 2 at each
+// node, the angle between a segment and its rest direction read in the Bishop frame of
+// the segment before it, carried from the head without twist. Their forces are that
+// energy's negative gradient, the change of the frames' twist included: checked by
+// central differences on a folded, twisted wisp (a 110-degree fold after a 2.7 mm segment)
+// bent away from its rest shape. A target turned with a frame that takes no reaction is
+// not a gradient, and on such a fold it pumps energy into a wisp that should rest.
+TEST(PlanteWisp, BendingForcesAreTheNegativeGradientOfTheBendingEnergy) {
+  namespace k = kernels;
+  const k::WispSystem s = hand_wisp(kFoldedWisp, 0.002f);
+  const std::uint32_t n = static_cast<std::uint32_t>(s.node_count());
+  const float stiffness = k::WispParams{}.bending_stiffness;
   auto energy = [&](const std::vector<Vec3f>& x) {
     k::WispSystem e = s;
     for (std::uint32_t i = 1; i < n; ++i) e.seg_t[i] = (x[i] - x[i - 1]).normalized();
@@ -507,25 +573,104 @@ TEST(PlanteWisp, BendingForcesAreTheNegativeGradientOfTheBendingEnergy) {
       const Eigen::Vector3d target = (bl.x() * u + bl.y() * tp.cross(u) + bl.z() * tp).cast<double>();
       const Eigen::Vector3d t = e.seg_t[i].cast<double>();
       const double angle = std::atan2(t.cross(target).norm(), t.dot(target));
-      sum += 0.5 * p.bending_stiffness * s.bend_scale[i] * angle * angle;
+      sum += 0.5 * stiffness * s.bend_scale[i] * angle * angle;
     }
     return sum;
   };
   EXPECT_LT(energy(s.rest_x), 1e-9) << "the rest shape is the energy's minimum";
-  double largest = 0.0, worst = 0.0;
-  const float step = 1e-5f;
-  for (std::uint32_t i = 2; i < n; ++i)
-    for (int d = 0; d < 3; ++d) {
-      std::vector<Vec3f> plus = s.x, minus = s.x;
-      plus[i][d] += step;
-      minus[i][d] -= step;
-      const double gradient = (energy(plus) - energy(minus)) / (double(plus[i][d]) - double(minus[i][d]));
-      const double force = double(s.acc[i][d]) * s.mass[i];
-      largest = std::max(largest, std::abs(force));
-      worst = std::max(worst, std::abs(force + gradient));
-    }
+  const auto [largest, worst] = gradient_check(s, k::BendingLaw::kBishop, energy);
   ASSERT_GT(largest, 1.0) << "the wisp is bent away from its rest shape";
   EXPECT_LT(worst, 1e-3 * largest) << "largest force " << largest;
+}
+
+// The paper's bending springs (§3.2, bending 0: kernels::paper_bending) derive from the
+// energy sum_k k bend_scale (theta_k - theta0_k)^2 / 2, theta_k the angle between the
+// segments meeting at node k-1 and theta0_k its rest angle: the kernel's forces are its
+// negative gradient by central differences, on the folded wisp and on a planar arc of
+// 25-degree bends, each bent away from its rest shape (out of the arc's plane too).
+TEST(PlanteWisp, PaperBendingForcesAreTheNegativeGradientOfTheAngleEnergy) {
+  namespace k = kernels;
+  const float stiffness = k::WispParams{}.bending_stiffness;
+  for (const auto& rest : {kFoldedWisp, planar_arc(0.44f, 7)}) {
+    const k::WispSystem s = hand_wisp(rest, 0.002f);
+    const std::uint32_t n = static_cast<std::uint32_t>(s.node_count());
+    auto energy = [&](const std::vector<Vec3f>& x) {
+      double sum = 0.0;
+      for (std::uint32_t i = 2; i < n; ++i) {
+        const Eigen::Vector3d tp = (x[i - 1] - x[i - 2]).cast<double>().normalized();
+        const Eigen::Vector3d t = (x[i] - x[i - 1]).cast<double>().normalized();
+        const double d = std::atan2(tp.cross(t).norm(), tp.dot(t)) - double(s.rest_bend[i]);
+        sum += 0.5 * stiffness * s.bend_scale[i] * d * d;
+      }
+      return sum;
+    };
+    EXPECT_LT(energy(s.rest_x), 1e-9) << "the rest angles are the rest skeleton's";
+    const auto [largest, worst] = gradient_check(s, k::BendingLaw::kPaper, energy);
+    std::printf("paper bending: largest force %.4g, largest |force + gradient| %.3g\n", largest, worst);
+    ASSERT_GT(largest, 1.0) << "the wisp is bent away from its rest shape";
+    EXPECT_LT(worst, 1e-3 * largest) << "largest force " << largest;
+  }
+}
+
+// On a straight rest wisp the rest direction of every segment is the direction of the one
+// before it, whatever the Bishop frames, so the two laws are one spring on the bend angle:
+// bent out of line in 3D, paper and bishop give the same forces to rounding.
+TEST(PlanteWisp, PaperAndBishopBendingAgreeOnAStraightRestWisp) {
+  namespace k = kernels;
+  std::vector<Vec3f> line;
+  for (int i = 0; i < 9; ++i) line.push_back(Vec3f(0.001f, 0.01f, 0.002f) * static_cast<float>(i));
+  const k::WispSystem s = hand_wisp(line, 0.002f);
+  const auto paper = bending_forces(s, k::BendingLaw::kPaper), bishop = bending_forces(s, k::BendingLaw::kBishop);
+  std::printf("straight rest wisp: largest force %.4g, largest difference %.3g\n", largest_free(s, bishop),
+              largest_difference(s, paper, bishop));
+  ASSERT_GT(largest_free(s, bishop), 1.0) << "the wisp is bent away from its rest shape";
+  EXPECT_LT(largest_difference(s, paper, bishop), 1e-5 * largest_free(s, bishop));
+}
+
+// On a curved rest wisp the laws differ by the bends' azimuth alone. A planar arc of
+// 25-degree bends: at rest neither law pushes; bent within its plane (no azimuth
+// changes) they give the same forces to rounding; with the part beyond node 4 turned
+// 60 degrees about the axis of segment (3, 4), which keeps every bend angle, the paper's
+// springs give no force (to rounding), while the Bishop springs pull the bend at node 4
+// back towards its rest azimuth.
+TEST(PlanteWisp, PaperAndBishopBendingDifferOnlyByTheAzimuthOnACurvedWisp) {
+  namespace k = kernels;
+  const std::vector<Vec3f> arc = planar_arc(0.44f, 7);
+  const k::WispSystem rest = hand_wisp(arc, 0.0f);
+  EXPECT_EQ(largest_free(rest, bending_forces(rest, k::BendingLaw::kPaper)), 0.0);
+  const double rest_bishop = largest_free(rest, bending_forces(rest, k::BendingLaw::kBishop));
+  std::printf("arc at rest: largest force bishop %.3g\n", rest_bishop);
+  EXPECT_LT(rest_bishop, 1e-3);
+
+  k::WispSystem in_plane = hand_wisp(arc, 0.0005f);
+  for (Vec3f& x : in_plane.x) x.z() = 0.0f;
+  const auto paper = bending_forces(in_plane, k::BendingLaw::kPaper);
+  const auto bishop = bending_forces(in_plane, k::BendingLaw::kBishop);
+  std::printf("arc bent in its plane: largest force %.4g, largest difference %.3g\n", largest_free(in_plane, bishop),
+              largest_difference(in_plane, paper, bishop));
+  ASSERT_GT(largest_free(in_plane, bishop), 1.0) << "the arc is bent within its plane";
+  EXPECT_LT(largest_difference(in_plane, paper, bishop), 1e-4 * largest_free(in_plane, bishop));
+
+  k::WispSystem turned = hand_wisp(arc, 0.0f);
+  const Eigen::AngleAxisf turn(std::numbers::pi_v<float> / 3.0f, (arc[4] - arc[3]).normalized());
+  for (std::size_t i = 5; i < arc.size(); ++i) turned.x[i] = arc[4] + turn * (arc[i] - arc[4]);
+  const double azimuth = largest_free(turned, bending_forces(turned, k::BendingLaw::kBishop));
+  std::printf("arc turned 60 degrees about segment (3, 4): largest force bishop %.4g, paper %.3g\n", azimuth,
+              largest_free(turned, bending_forces(turned, k::BendingLaw::kPaper)));
+  EXPECT_GT(azimuth, 1.0) << "the Bishop springs remember the bend's azimuth";
+  EXPECT_LT(largest_free(turned, bending_forces(turned, k::BendingLaw::kPaper)), 1e-4 * azimuth);
+}
+
+// The paper's bending law (bending 0) runs a built-in scenario to its verdict: `shake`
+// (every 8th strand) with plante_wisp, through the shake and its stop.
+TEST(PlanteWisp, PapersBendingLawRunsTheShakeToAVerdict) {
+  const auto runs = test::run(builtin("shake", 8), {"plante_wisp"}, {{"plante_wisp", "bending", 0}});
+  const RunRecord& r = test::find(runs, "plante_wisp");
+  ASSERT_FALSE(r.failure.has_value());
+  std::printf("bending 0 on shake/8: %s (%s), rest-shape error at the end %.4f\n",
+              std::string(verdict::status_name(r.verdict.status)).c_str(), r.verdict.reason.c_str(),
+              r.rest_shape_error.back());
+  EXPECT_EQ(verdict::status_name(r.verdict.status), "ok") << r.verdict.reason;
 }
 
 // Guide 106 of the shipped ponytail (it rises 2 cm and folds back over a 2 mm edge, 110
@@ -775,25 +920,29 @@ TEST(PlanteWisp, BendAngleWithin3UlpOfLibm) {
 }
 
 // The baseline and x86-64-v4 builds of the block and narrow-phase kernels give the same
-// bits (FMA contraction off; every lane performs the per-wisp kernels' operations).
+// bits (FMA contraction off; every lane performs the per-wisp kernels' operations), with
+// either bending law.
 TEST(PlanteWisp, IsaVariantsGiveTheSameBits) {
   const Scenario sc = builtin("shake", 8);
-  const ParamSet params = plante_params(sc.groom);
-  plante::PlanteWispModel best(ModelContext{nullptr}), base(ModelContext{nullptr});
-  base.use_kernels(kernels::wisp_soa::kernels_baseline());
-  best.reset(sc.groom, params);
-  base.reset(sc.groom, params);
-  ASSERT_GT(best.block_wisps(), 0u) << "no wisp runs in a block: the test would not reach the block kernels";
-  std::size_t contacts = 0;
-  for (int f = 0; f < 30; ++f) {
-    StageTimes t;
-    best.step(frame_input(sc, f), t);
-    base.step(frame_input(sc, f), t);
-    contacts += best.contacts().size();
+  for (const double bending : {1.0, 0.0}) {
+    SCOPED_TRACE(bending == 0.0 ? "bending paper" : "bending bishop");
+    const ParamSet params = plante_params(sc.groom, {{"bending", bending}});
+    plante::PlanteWispModel best(ModelContext{nullptr}), base(ModelContext{nullptr});
+    base.use_kernels(kernels::wisp_soa::kernels_baseline());
+    best.reset(sc.groom, params);
+    base.reset(sc.groom, params);
+    ASSERT_GT(best.block_wisps(), 0u) << "no wisp runs in a block: the test would not reach the block kernels";
+    std::size_t contacts = 0;
+    for (int f = 0; f < 30; ++f) {
+      StageTimes t;
+      best.step(frame_input(sc, f), t);
+      base.step(frame_input(sc, f), t);
+      contacts += best.contacts().size();
+    }
+    EXPECT_GT(contacts, 0u) << "no wisp-wisp contact: the narrow phase found nothing to compare";
+    EXPECT_EQ(metrics::state_hash(best.positions()), metrics::state_hash(base.positions()))
+        << kernels::simd::isa_name(kernels::simd::runtime_isa());
   }
-  EXPECT_GT(contacts, 0u) << "no wisp-wisp contact: the narrow phase found nothing to compare";
-  EXPECT_EQ(metrics::state_hash(best.positions()), metrics::state_hash(base.positions()))
-      << kernels::simd::isa_name(kernels::simd::runtime_isa());
 }
 
 }  // namespace

@@ -19,8 +19,8 @@
 // defaults keep the explicit integration stable at 1000 Hz with the highest axial mode
 // at omega h ~ 1.3 (< 2), and hold a 25 cm wisp's skeleton within 2% of its rest length
 // under gravity (idle: 1.9% at most, next to the root). The bending springs derive from
-// an energy (see wisp_forces_and_velocities); their zigzag mode has omega^2 ~ 16 k, so
-// explicit integration at 1000 Hz holds up to k ~ 2.5e5 (measured on `idle` without
+// an energy (kernels::bishop_bending, kernels::paper_bending); their zigzag mode has
+// omega^2 ~ 16 k, so explicit integration at 1000 Hz holds up to k ~ 2.5e5 (measured on `idle` without
 // gravity: `ok` at 2e5, the probe growing at 2.5e5 and 4e5). 1e5 (omega h ~
 // 1.3) is the stiffest default with that margin; it holds the style against metric
 // gravity far better than 5e3 (rest_shape_error on `idle` 0.049 L-bar against 0.12).
@@ -29,6 +29,18 @@
 // Stiffer bending also bounds the bend changes at the nodes, which the rebuilt strands
 // turn into edge length error (wisp_width_max). None of these numbers are the paper's
 // (it gives none).
+//
+// `bending` chooses the bending springs' law (parameters take numbers only: 0 paper, 1
+// bishop). §3.2 gives "a damped spring for which the force increases linearly with the
+// bending angle": bending 0 is that spring on the angle between consecutive segments,
+// towards its rest angle (kernels::paper_bending). It has no azimuth, so a curved wisp
+// rests in any turn of a bent segment about the one before it, and holds a curved style
+// only as far as gravity and contacts leave its bends' planes alone (§6 leaves the
+// style's memory to oriented particles). The default, 1, springs each segment towards its
+// rest direction in Bishop frames (kernels::bishop_bending): the paper's angle spring
+// where the rest wisp is straight, and the bend's azimuth besides where it is curved.
+// It stays the default because it holds the groom's style (docs/plante-wisp.md, the
+// bending springs; docs/limitations.md has what the paper's law does on curved wisps).
 //
 // Also ours, not the paper's (docs/plante-wisp.md): the body is the head sphere and the
 // scenario's sphere colliders, not the character's polygons (§4.2), so that every model
@@ -53,7 +65,7 @@ namespace hairbench::plante {
 // and 7.7 segments on average in its three styles (§5.3).
 inline constexpr int kMinSegments = 4, kMaxSegments = 10;
 
-inline constexpr std::array<ParamSpec, 26> kParams{{
+inline constexpr std::array<ParamSpec, 27> kParams{{
     {"strands_per_wisp", 3, 1, 10000, true,
      "groom strands per wisp when `wisps` is 0: wisps = round(strands / strands_per_wisp) (§3.1)"},
     {"wisps", 0, 0, 1000000, true, "number of wisps (0: from strands_per_wisp); root-weighted k-means on the rest strands"},
@@ -75,6 +87,10 @@ inline constexpr std::array<ParamSpec, 26> kParams{{
     {"bending_stiffness", 1e5, 0, 1e6, false,
      "bending springs: lateral acceleration = k * angle * segment rest length, 1/s^2 (§3.2)"},
     {"bending_damping", 60, 0, 1000, false, "damping of the relative lateral velocity, 1/s (§3.2)"},
+    {"bending", 1, 0, 1, true,
+     "bending law: 0 paper (§3.2 as written: a spring on the angle between consecutive segments, towards its "
+     "rest angle; no azimuth), 1 bishop (towards each segment's rest direction in Bishop frames: the angle "
+     "and its azimuth, the style's memory)"},
     {"envelope_mass", 0.1, 1e-3, 1, false, "envelope mass / skeleton mass (§3.3: much lighter)"},
     {"radial_stiffness", 5e4, 0, 1e6, false,
      "envelope-skeleton springs at rest, 1/s^2; compression stiffens as r0/r (§3.3)"},

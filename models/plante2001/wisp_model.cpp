@@ -185,7 +185,8 @@ struct Skeleton {
 // groom's curls diverges at rest (PlanteWisp.CurlyGroomStaysOkAtRest without the
 // bounds): near a half turn the frames carried by minimal rotation turn over, and the
 // bending springs' twist loads grow as the curvature binormal, 2 tan(bend / 2)
-// (wisp_forces_and_velocities); next to a pinned node the section frame bisects the
+// (kernels::bishop_bending; the skeleton is the same for either law, so that they
+// compare on one skeleton); next to a pinned node the section frame bisects the
 // head's segment and the first free one, and turns over as they fold back onto each
 // other. Where the mean curve
 // bends more at the nodes of the width's resolution, the skeleton is first made finer,
@@ -452,6 +453,7 @@ void WispModel::reset(const Groom& rest, const ParamSet& params) {
     p.axial_damping = f("axial_damping");
     p.bending_stiffness = f("bending_stiffness");
     p.bending_damping = f("bending_damping");
+    p.bending = params.get_int("bending", r) == 0 ? k::BendingLaw::kPaper : k::BendingLaw::kBishop;
     p.envelope_mass = f("envelope_mass");
     p.radial_stiffness = f("radial_stiffness");
     p.radial_stretch = f("radial_stretch");

@@ -218,90 +218,120 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       acc[i].set(l, sub(acc[i].get(l), mul(f * inv_mass[i * W + l], t)));
     }
   }
-  // Bending springs (wisp_forces_and_velocities): the Bishop frames from the head-carried
-  // one of the first segment (Eigen's expressions per lane, as there), the springs, then
-  // their loads on the frames' twist, tip to root.
-  V3 root_t;
-  {
-    V3 u;
-    for (int l = 0; l < W; ++l) {
-      const std::uint32_t w = s.node_wisp[blk.base[l]];
-      const Vec3f rt = head_rot * s.root_t[w], ru = head_rot * s.rest_e1[w];
-      root_t.set(l, {rt.x(), rt.y(), rt.z()});
-      u.set(l, {ru.x(), ru.y(), ru.z()});
-    }
-    for (int i = 1; i < n; ++i) {
-      const V3& prev = i > 1 ? seg_t[i - 1] : root_t;
-      LANES {
-        const F3 t = seg_t[i].get(l), prev_t = prev.get(l), ul = u.get(l);
-        const float c = dot(prev_t, t);
-        bad[l] |= 1.0f + c < 1e-6f;
-        const F3 k_axis = cross(prev_t, t);
-        const F3 kap = mul(1.0f / (1.0f + c), k_axis);
-        kappa[i].set(l, kap);
-        const F3 turned = add(add(mul(c, ul), cross(k_axis, ul)), mul(dot(k_axis, ul), kap));
-        const F3 normal = sub(turned, mul(dot(turned, t), t));
-        const float n2 = dot(normal, normal);
-        bad[l] |= !(n2 > 1e-24f);
-        const F3 ui = mul(1.0f / std::sqrt(n2), normal);
-        u.set(l, ui);
-        bishop_u[i].set(l, ui);
-      }
-    }
-  }
-  for (int k = 0; k < n * W; ++k) twist_load[k] = 0.0f;
   float sin_angle[W], angle[W];
   F3 axis[W];
-  for (int i = 2; i < n; ++i) {
-    LANES {
-      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), u = bishop_u[i - 1].get(l);
-      const F3 b = bl[i].get(l);
-      const F3 target = add(add(mul(b.x, u), mul(b.y, cross(t_prev, u))), mul(b.z, t_prev));
-      axis[l] = cross(target, t);
-      sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
-      angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(target, t)) : 0.0f;
-      bl[i].set(l, target);  // the target from here on
-    }
-    LANES {
-      const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), target = bl[i].get(l);
-      const bool bends = sin_angle[l] > 1e-7f;
-      const float q = p.bending_stiffness * angle[l] * bend_scale[i * W + l] / sin_angle[l];
-      const F3 zero{0.0f, 0.0f, 0.0f};
-      const F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(target, mul(dot(target, t), t))), zero);
-      const F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], cross(t_prev, axis[l])), zero);
-      twist_load[(i - 1) * W + l] = bends ? -q * dot(t_prev, axis[l]) : 0.0f;
-      const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
-      const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
-      acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
-      acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
-      acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
-    }
-  }
-  {
-    // Segment i's bend turns the frames of segments i.. : its load is the sum of theirs.
-    // Nodes i and i - 1 take the part through segment i, nodes i - 1 and i - 2 the part
-    // through segment i - 1 (none for i = 1: segment 0 is the head's).
-    float load[W];
-    LANES load[l] = 0.0f;
-    // A lane whose segment has no length is bad (the axial springs): the others need no
-    // test.
-    for (int i = n - 1; i > 1; --i) {
+  if (p.bending == BendingLaw::kPaper) {
+    // The paper's springs on the bend angles (§3.2, paper_bending): no frames.
+    float rest_bend[N * W];
+    blk.load(rest_bend, s.rest_bend, 1);
+    for (int i = 2; i < n; ++i) {
+      float cos_angle[W];
       LANES {
-        load[l] += twist_load[i * W + l];
-        const F3 kap = kappa[i].get(l);
-        const F3 fn = mul(load[l] * seg_inv_len[i * W + l], kap);
-        const F3 fp = mul(load[l] * seg_inv_len[(i - 1) * W + l], kap);
-        acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], fn)));
-        const F3 ai1 = sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], fn));
-        acc[i - 1].set(l, add(ai1, mul(inv_mass[(i - 1) * W + l], fp)));
-        acc[i - 2].set(l, sub(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fp)));
+        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+        axis[l] = cross(t_prev, t);
+        sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
+        cos_angle[l] = dot(t_prev, t);
+        angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], cos_angle[l]) : 0.0f;
+      }
+      LANES {
+        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+        const bool bends = sin_angle[l] > 1e-7f;
+        const float c = cos_angle[l];
+        const float q = p.bending_stiffness * (angle[l] - rest_bend[i * W + l]) * bend_scale[i * W + l] / sin_angle[l];
+        const F3 zero{0.0f, 0.0f, 0.0f};
+        const F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(t_prev, mul(c, t))), zero);
+        const F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], sub(mul(c, t_prev), t)), zero);
+        const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
+        const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
+        acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
+        acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
+        acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
       }
     }
-    LANES {
-      load[l] += twist_load[W + l];
-      const F3 fn = mul(load[l] * seg_inv_len[W + l], kappa[1].get(l));
-      acc[1].set(l, add(acc[1].get(l), mul(inv_mass[W + l], fn)));
-      acc[0].set(l, sub(acc[0].get(l), mul(inv_mass[l], fn)));
+  } else {
+    // Bending springs (bishop_bending): the Bishop frames from the head-carried
+    // one of the first segment (Eigen's expressions per lane, as there), the springs, then
+    // their loads on the frames' twist, tip to root.
+    V3 root_t;
+    {
+      V3 u;
+      for (int l = 0; l < W; ++l) {
+        const std::uint32_t w = s.node_wisp[blk.base[l]];
+        const Vec3f rt = head_rot * s.root_t[w], ru = head_rot * s.rest_e1[w];
+        root_t.set(l, {rt.x(), rt.y(), rt.z()});
+        u.set(l, {ru.x(), ru.y(), ru.z()});
+      }
+      for (int i = 1; i < n; ++i) {
+        const V3& prev = i > 1 ? seg_t[i - 1] : root_t;
+        LANES {
+          const F3 t = seg_t[i].get(l), prev_t = prev.get(l), ul = u.get(l);
+          const float c = dot(prev_t, t);
+          bad[l] |= 1.0f + c < 1e-6f;
+          const F3 k_axis = cross(prev_t, t);
+          const F3 kap = mul(1.0f / (1.0f + c), k_axis);
+          kappa[i].set(l, kap);
+          const F3 turned = add(add(mul(c, ul), cross(k_axis, ul)), mul(dot(k_axis, ul), kap));
+          const F3 normal = sub(turned, mul(dot(turned, t), t));
+          const float n2 = dot(normal, normal);
+          bad[l] |= !(n2 > 1e-24f);
+          const F3 ui = mul(1.0f / std::sqrt(n2), normal);
+          u.set(l, ui);
+          bishop_u[i].set(l, ui);
+        }
+      }
+    }
+    for (int k = 0; k < n * W; ++k) twist_load[k] = 0.0f;
+    for (int i = 2; i < n; ++i) {
+      LANES {
+        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), u = bishop_u[i - 1].get(l);
+        const F3 b = bl[i].get(l);
+        const F3 target = add(add(mul(b.x, u), mul(b.y, cross(t_prev, u))), mul(b.z, t_prev));
+        axis[l] = cross(target, t);
+        sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
+        angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(target, t)) : 0.0f;
+        bl[i].set(l, target);  // the target from here on
+      }
+      LANES {
+        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), target = bl[i].get(l);
+        const bool bends = sin_angle[l] > 1e-7f;
+        const float q = p.bending_stiffness * angle[l] * bend_scale[i * W + l] / sin_angle[l];
+        const F3 zero{0.0f, 0.0f, 0.0f};
+        const F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(target, mul(dot(target, t), t))), zero);
+        const F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], cross(t_prev, axis[l])), zero);
+        twist_load[(i - 1) * W + l] = bends ? -q * dot(t_prev, axis[l]) : 0.0f;
+        const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
+        const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
+        acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
+        acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
+        acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
+      }
+    }
+    {
+      // Segment i's bend turns the frames of segments i.. : its load is the sum of theirs.
+      // Nodes i and i - 1 take the part through segment i, nodes i - 1 and i - 2 the part
+      // through segment i - 1 (none for i = 1: segment 0 is the head's).
+      float load[W];
+      LANES load[l] = 0.0f;
+      // A lane whose segment has no length is bad (the axial springs): the others need no
+      // test.
+      for (int i = n - 1; i > 1; --i) {
+        LANES {
+          load[l] += twist_load[i * W + l];
+          const F3 kap = kappa[i].get(l);
+          const F3 fn = mul(load[l] * seg_inv_len[i * W + l], kap);
+          const F3 fp = mul(load[l] * seg_inv_len[(i - 1) * W + l], kap);
+          acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], fn)));
+          const F3 ai1 = sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], fn));
+          acc[i - 1].set(l, add(ai1, mul(inv_mass[(i - 1) * W + l], fp)));
+          acc[i - 2].set(l, sub(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fp)));
+        }
+      }
+      LANES {
+        load[l] += twist_load[W + l];
+        const F3 fn = mul(load[l] * seg_inv_len[W + l], kappa[1].get(l));
+        acc[1].set(l, add(acc[1].get(l), mul(inv_mass[W + l], fn)));
+        acc[0].set(l, sub(acc[0].get(l), mul(inv_mass[l], fn)));
+      }
     }
   }
   // A wisp pinned at its tip as well: its last free segment's bending spring towards the

@@ -30,6 +30,7 @@ void WispSystem::resize_state() {
   inv_mass.assign(n, 0.0f);
   bend_scale.assign(n, 0.0f);
   bend_local.assign(n, Vec3f::Zero());
+  rest_bend.assign(n, 0.0f);
   e1.assign(n, Vec3f::UnitX());
   e2.assign(n, Vec3f::UnitY());
   this->n.assign(n, Vec3f::UnitZ());
@@ -247,6 +248,18 @@ void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend) {
   // frame of the first segment is rest_e1 about its own direction root_t.
   s.root_t[w] = n0;
   if (e - b < 3) return;
+  // The rest angles of the paper's springs, from the segments' directions as the axial
+  // springs' pass computes them (wisp_forces_and_velocities), so that the rest skeleton
+  // gives paper_bending its rest angles to the bit.
+  Vec3f prev_t = Vec3f::Zero();
+  for (std::uint32_t k = b + 1; k < e; ++k) {
+    const Vec3f d = s.rest_x[k] - s.rest_x[k - 1];
+    const float len = d.norm();
+    const Vec3f t = (1.0f / len) * d;
+    if (k >= b + 2 && len > 0.0f && s.rest_len[k - 1] > 0.0f)
+      s.rest_bend[k] = atan2_upper(prev_t.cross(t).norm(), prev_t.dot(t));
+    prev_t = t;
+  }
   for (std::uint32_t k = b + 1; k < e; ++k) s.seg_t[k] = unit_or(s.rest_x[k] - s.rest_x[k - 1], n0);
   bishop_frames(s, w, s.root_t[w], s.rest_e1[w]);
   for (std::uint32_t k = b + 2; k < e; ++k) {
@@ -266,60 +279,31 @@ void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h) {
   }
 }
 
-void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
-                                const Vec3f& gravity, const Wind& wind, float h) {
+// Damped bending springs whose force grows linearly with the bending angle (§3.2),
+// towards the rest style: segment (k-1, k) is turned towards its rest direction in the
+// Bishop frame of segment (k-2, k-1) (bishop_frames: the head-carried frame of the
+// first segment, carried segment to segment by minimal rotation, §3.3's "quaternion
+// that minimally rotates"), with the energy k bend_scale angle^2 / 2 (bend_scale = L0^2
+// m, L0 and m the shorter rest length and lighter hair of the two segments: the lateral
+// acceleration on nodes k and k-2, torque / length^2 / mass, stays at most about k
+// whatever their ratio; wisp_init_rest). The forces are that energy's exact negative
+// gradient, so the springs neither pump energy nor push the wisp as a whole:
+//  - through segment (k-1, k), on nodes k and k-1;
+//  - through segment (k-2, k-1), which carries the frame, on nodes k-1 and k-2;
+//  - through the frame's twist about segment (k-2, k-1), which every bend between the
+//    head and that segment sets (the frames' holonomy). A bend between segments e_prev
+//    and e, kappa_b = 2 t_prev x t / (1 + t_prev . t) its curvature binormal, adds to
+//    the twist of the frames after it kappa_b . dx / (2 |e_prev|) for a move dx of
+//    e_prev's first node, -kappa_b . dx / (2 |e|) for one of e's last node, and minus
+//    their sum for the node between: the holonomy gradient of discrete elastic rods
+//    (Bergou et al. 2008). The springs' loads on the twist (twist_load) are summed tip
+//    to root and applied per node in one pass.
+// Without the twist's part (a target that turns only with segment (k-2, k-1)) the
+// springs are a follower load, which a fold of the style turns into flutter with the
+// head still: a ponytail guide folded 110 degrees over a 2 mm segment, resampled to 32
+// vertices (tests/plante_test.cpp).
+void bishop_bending(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot) {
   const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
-  const Vec3f wind_acc = wind.acceleration();
-  const bool windy = wind.active();
-  // Gravity, air resistance and wind (the part of it that meets the segment face-on).
-  for (std::uint32_t k = b; k < e; ++k) {
-    Vec3f a = gravity - p.air_drag * s.v[k];
-    if (windy && k > b) {
-      const Vec3f t = unit_or(s.x[k] - s.x[k - 1], Vec3f::Zero());
-      a += wind_acc - wind_acc.dot(t) * t;
-    }
-    s.acc[k] = a;
-  }
-  // Linear damped axial springs (§3.2): the force of segment (k-1, k) is its hair times
-  // the stiffness times the stretch, each end accelerated by that over its mass.
-  // Each segment's length and direction are kept for the bending springs.
-  for (std::uint32_t k = b + 1; k < e; ++k) {
-    const Vec3f d = s.x[k] - s.x[k - 1];
-    const float len = d.norm();
-    s.seg_len[k] = len;
-    if (!(len > 0.0f)) continue;
-    const float inv_len = 1.0f / len;
-    s.seg_inv_len[k] = inv_len;
-    const Vec3f t = inv_len * d;
-    s.seg_t[k] = t;
-    const float f =
-        s.seg_mass[k] * (p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t));
-    s.acc[k - 1] += (f * s.inv_mass[k - 1]) * t;
-    s.acc[k] -= (f * s.inv_mass[k]) * t;
-  }
-  // Damped bending springs whose force grows linearly with the bending angle (§3.2),
-  // towards the rest style: segment (k-1, k) is turned towards its rest direction in the
-  // Bishop frame of segment (k-2, k-1) (bishop_frames: the head-carried frame of the
-  // first segment, carried segment to segment by minimal rotation, §3.3's "quaternion
-  // that minimally rotates"), with the energy k bend_scale angle^2 / 2 (bend_scale = L0^2
-  // m, L0 and m the shorter rest length and lighter hair of the two segments: the lateral
-  // acceleration on nodes k and k-2, torque / length^2 / mass, stays at most about k
-  // whatever their ratio; wisp_init_rest). The forces are that energy's exact negative
-  // gradient, so the springs neither pump energy nor push the wisp as a whole:
-  //  - through segment (k-1, k), on nodes k and k-1;
-  //  - through segment (k-2, k-1), which carries the frame, on nodes k-1 and k-2;
-  //  - through the frame's twist about segment (k-2, k-1), which every bend between the
-  //    head and that segment sets (the frames' holonomy). A bend between segments e_prev
-  //    and e, kappa_b = 2 t_prev x t / (1 + t_prev . t) its curvature binormal, adds to
-  //    the twist of the frames after it kappa_b . dx / (2 |e_prev|) for a move dx of
-  //    e_prev's first node, -kappa_b . dx / (2 |e|) for one of e's last node, and minus
-  //    their sum for the node between: the holonomy gradient of discrete elastic rods
-  //    (Bergou et al. 2008). The springs' loads on the twist (twist_load) are summed tip
-  //    to root and applied per node in one pass.
-  // Without the twist's part (a target that turns only with segment (k-2, k-1)) the
-  // springs are a follower load, which a fold of the style turns into flutter with the
-  // head still: a ponytail guide folded 110 degrees over a 2 mm segment, resampled to 32
-  // vertices (tests/plante_test.cpp).
   bishop_frames(s, w, head_rot * s.root_t[w], head_rot * s.rest_e1[w]);
   for (std::uint32_t k = b + 1; k < e; ++k) s.twist_load[k] = 0.0f;
   for (std::uint32_t k = b + 2; k < e; ++k) {
@@ -361,6 +345,75 @@ void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& 
       s.acc[k - 1] += fp * s.inv_mass[k - 1];
       s.acc[k - 2] -= fp * s.inv_mass[k - 2];
     }
+  }
+}
+
+void paper_bending(std::uint32_t n, const Vec3f* t, const float* len, const float* inv_len, const float* rest_bend,
+                   const float* bend_scale, const float* seg_mass, const float* inv_mass, const Vec3f* v,
+                   float stiffness, float damping, Vec3f* acc) {
+  for (std::uint32_t k = 2; k < n; ++k) {
+    if (!(len[k] > 0.0f) || !(len[k - 1] > 0.0f)) continue;
+    const Vec3f& tk = t[k];
+    const Vec3f& t_prev = t[k - 1];
+    // theta_k from |t_prev x t| and t_prev . t (atan2_upper, as bishop_bending reads its
+    // angle). With q = dE_k/d(theta) / sin(theta) (E_k: wisp_kernels.h) the forces are q
+    // times the gradient of cos(theta) = t_prev . t: (t_prev - cos t) / len[k] on node k,
+    // (cos t_prev - t) / len[k-1] on node k-2.
+    const Vec3f axis = t_prev.cross(tk);
+    const float sin_angle = axis.norm();
+    Vec3f fk = Vec3f::Zero(), fk2 = Vec3f::Zero();
+    if (sin_angle > 1e-7f) {
+      const float cos_angle = t_prev.dot(tk);
+      const float q = stiffness * (atan2_upper(sin_angle, cos_angle) - rest_bend[k]) * bend_scale[k] / sin_angle;
+      fk = (q * inv_len[k]) * (t_prev - cos_angle * tk);
+      fk2 = (q * inv_len[k - 1]) * (cos_angle * t_prev - tk);
+    }
+    const Vec3f dv = v[k] - v[k - 1];
+    const Vec3f damp = (damping * seg_mass[k]) * (dv - dv.dot(tk) * tk);
+    acc[k] += (fk - damp) * inv_mass[k];
+    acc[k - 2] += fk2 * inv_mass[k - 2];
+    acc[k - 1] -= (fk + fk2 - damp) * inv_mass[k - 1];
+  }
+}
+
+void wisp_forces_and_velocities(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot,
+                                const Vec3f& gravity, const Wind& wind, float h) {
+  const std::uint32_t b = s.node_begin[w], e = s.node_begin[w + 1];
+  const Vec3f wind_acc = wind.acceleration();
+  const bool windy = wind.active();
+  // Gravity, air resistance and wind (the part of it that meets the segment face-on).
+  for (std::uint32_t k = b; k < e; ++k) {
+    Vec3f a = gravity - p.air_drag * s.v[k];
+    if (windy && k > b) {
+      const Vec3f t = unit_or(s.x[k] - s.x[k - 1], Vec3f::Zero());
+      a += wind_acc - wind_acc.dot(t) * t;
+    }
+    s.acc[k] = a;
+  }
+  // Linear damped axial springs (§3.2): the force of segment (k-1, k) is its hair times
+  // the stiffness times the stretch, each end accelerated by that over its mass.
+  // Each segment's length and direction are kept for the bending springs.
+  for (std::uint32_t k = b + 1; k < e; ++k) {
+    const Vec3f d = s.x[k] - s.x[k - 1];
+    const float len = d.norm();
+    s.seg_len[k] = len;
+    if (!(len > 0.0f)) continue;
+    const float inv_len = 1.0f / len;
+    s.seg_inv_len[k] = inv_len;
+    const Vec3f t = inv_len * d;
+    s.seg_t[k] = t;
+    const float f =
+        s.seg_mass[k] * (p.axial_stiffness * (len - s.rest_len[k]) + p.axial_damping * (s.v[k] - s.v[k - 1]).dot(t));
+    s.acc[k - 1] += (f * s.inv_mass[k - 1]) * t;
+    s.acc[k] -= (f * s.inv_mass[k]) * t;
+  }
+  // Damped bending springs (§3.2): the paper's law on the bend angles, or towards the rest
+  // directions in Bishop frames (settings.h `bending`).
+  if (p.bending == BendingLaw::kPaper) {
+    paper_bending(e - b, &s.seg_t[b], &s.seg_len[b], &s.seg_inv_len[b], &s.rest_bend[b], &s.bend_scale[b],
+                  &s.seg_mass[b], &s.inv_mass[b], &s.v[b], p.bending_stiffness, p.bending_damping, &s.acc[b]);
+  } else {
+    bishop_bending(s, w, p, head_rot);
   }
   // A wisp pinned at its tip as well (TressFX strands pinned at both ends) ends in a
   // single pinned node, not in a pinned segment as at the root (§3.2): nothing else holds

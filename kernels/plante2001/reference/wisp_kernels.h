@@ -20,6 +20,16 @@
 
 namespace hairbench::kernels {
 
+// Which bending springs hold the skeleton (settings.h `bending`).
+enum class BendingLaw : std::uint8_t {
+  // §3.2 as written: a spring on the angle between consecutive segments, towards its rest
+  // angle (paper_bending).
+  kPaper = 0,
+  // Towards each segment's rest direction in the Bishop frame of the segment before it,
+  // the angle and the bend's azimuth (bishop_bending).
+  kBishop = 1,
+};
+
 // Physical parameters of one wisp (one per groom region).
 struct WispParams {
   float air_drag = 5.0f;            // 1/s, on every mass's absolute velocity (§5.1 "air resistance")
@@ -33,6 +43,7 @@ struct WispParams {
   float radial_damping = 300.0f;    // 1/s ("highly viscous" radial springs, §1 abstract)
   float ring_stiffness = 1e4f;      // 1/s^2, soft springs between a section's envelope masses
   float ring_damping = 200.0f;      // 1/s, "highly damped"
+  BendingLaw bending = BendingLaw::kBishop;
 };
 
 // Interaction parameters (§4), shared by all wisps.
@@ -87,6 +98,9 @@ struct WispSystem {
   // Rest direction of segment (k-1, k), stored at k, in the Bishop frame (u, t x u, t) of
   // segment (k-2, k-1) (bishop_frames).
   std::vector<Vec3f> bend_local;
+  // The rest angle of the bending spring at node k-1, between segments (k-2, k-1) and
+  // (k-1, k), stored at k, radians in [0, pi] (paper_bending).
+  std::vector<float> rest_bend;
   std::vector<Vec3f> root_t;      // per wisp: rest direction of its first segment, head rest frame
   // Scratch of wisp_forces_and_velocities: the Bishop frames' u of segment (k-1, k) at k,
   // half the curvature binormal of the bend between segments k-1 and k, (t_{k-1} x t_k) /
@@ -214,6 +228,36 @@ void wisp_init_rest(WispSystem& s, std::size_t w, int root_blend);
 // Pinned nodes follow the head transform `head`; their velocities are the displacement
 // over the step h.
 void wisp_pin(WispSystem& s, std::size_t w, const Affine3f& head, float h);
+
+// The bending springs of §3.2 as written: "a damped spring for which the force increases
+// linearly with the bending angle", on one wisp of n nodes whose arrays start at its
+// first node (segment (k-1, k) at k: unit direction t, length len and its inverse
+// inv_len, as the axial springs' pass leaves them; rest_bend, bend_scale, seg_mass,
+// inv_mass and v as in WispSystem). The spring at node k-1 acts on the angle
+//   theta_k = atan2(|t_{k-1} x t_k|, t_{k-1} . t_k)  in [0, pi]
+// between the segments that meet there, towards its rest angle theta0_k = rest_bend[k];
+// the paper gives no rest angle, and a spring's rest is the rest skeleton's. Its energy is
+//   E_k = stiffness bend_scale[k] (theta_k - theta0_k)^2 / 2,
+// and the forces are E_k's negative gradient on the angle's three nodes, of size
+// stiffness bend_scale (theta - theta0) / len on the nodes k and k-2 at the ends (linear in
+// the angle, as §3.2 says), the node between taking minus their sum: conservative, and
+// neither the wisp's momentum nor its angular momentum changes. The angle alone has no
+// azimuth: a bent segment turned about the segment before it keeps its angle and costs
+// nothing (the paper leaves style memory to oriented particles, §6). Where theta0 > 0 the
+// energy has a cone at theta = 0 (the straight segment pair is its local maximum, its
+// direction undefined): there, and at theta = pi, no force. The damping is bishop_bending's
+// (the lateral velocity of node k relative to node k-1), as both laws' springs are damped
+// alike. Adds to acc (accelerations, force over mass).
+void paper_bending(std::uint32_t n, const Vec3f* t, const float* len, const float* inv_len, const float* rest_bend,
+                   const float* bend_scale, const float* seg_mass, const float* inv_mass, const Vec3f* v,
+                   float stiffness, float damping, Vec3f* acc);
+
+// The bending springs towards the rest style (WispParams::bending kBishop, the default):
+// wisp w's segment (k-1, k) turned towards its rest direction bend_local[k] read in the
+// Bishop frame of segment (k-2, k-1), with the energy stiffness bend_scale angle^2 / 2 and
+// its exact gradient, the frames' twist included (see the definition). Expects seg_t,
+// seg_len and seg_inv_len of the current skeleton; adds to acc.
+void bishop_bending(WispSystem& s, std::size_t w, const WispParams& p, const Eigen::Matrix3f& head_rot);
 
 // §5.1 steps 1 and 3 (before modifications): forces, then v += a h for the skeleton
 // masses and rdot += a_r h for the envelope masses (their accelerations projected on
