@@ -129,6 +129,16 @@ class HairModel {
   // (core/device_metrics.h), valid until the next reset(); nullptr: the harness computes
   // them from positions().
   virtual DeviceMetrics* device_metrics() { return nullptr; }
+  // Strands the model holds rigid with the head because it cannot represent their pins
+  // (a tree grown from the root whose tip is pinned too), counted in the report
+  // (runs[].static_strands).
+  virtual std::size_t static_strands() const { return 0; }
+  // A model that simulates fewer nodes than the groom has vertices and draws the groom
+  // from them (Halén & Wester's, §5.5): the groom it simulates and its nodes' positions,
+  // whose edges its constraints hold (the stretched verdict reads them; the metrics read
+  // positions()). nullptr and empty: the model simulates every groom vertex.
+  virtual const Groom* simulated_groom() const { return nullptr; }
+  virtual std::span<const Vec4f> simulated_positions() const { return {}; }
 };
 
 }  // namespace hairbench

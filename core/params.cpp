@@ -70,4 +70,10 @@ void ParamSet::set_everywhere(std::string_view name, double value, const Origin&
   }
 }
 
+void ParamSet::scale(std::string_view name, double factor) {
+  if (auto it = base_.find(name); it != base_.end()) it->second *= factor;
+  for (auto& r : region_)
+    if (auto it = r.find(name); it != r.end()) it->second *= factor;
+}
+
 }  // namespace hairbench

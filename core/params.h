@@ -47,6 +47,11 @@ class ParamSet {
   // --set wins over everything a file says).
   void set_everywhere(std::string_view name, double value, const Origin& from);
 
+  // Multiplies the base value and every region override of `name` by `factor`, with no
+  // range check: for an adapter that turns a value given at one resolution into the one
+  // its model runs at (models/halen2007/nodes_model.h).
+  void scale(std::string_view name, double factor);
+
   bool has(std::string_view name) const;
   const std::map<std::string, double, std::less<>>& base() const { return base_; }
   const std::vector<std::map<std::string, double, std::less<>>>& regions() const { return region_; }

@@ -23,6 +23,7 @@ enum class Stage : std::uint8_t {
   BodyCollision,    // Plante's wisp-body collisions (§4.2)
   SelfInteraction,  // Plante's wisp-wisp interactions (§4.1)
   Rebuild,          // Plante's strands from their wisps (§3.4)
+  Interpolate,      // groom vertices drawn from Halén's simulated nodes (§5.5)
   FollowHairs,      // follow hairs generated from the guides (TressFX grooms)
   Sleep,            // the sleep checks of a calm scene
 };
@@ -30,7 +31,8 @@ inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Sleep
 
 inline constexpr std::array<std::string_view, kStageCount> kStageNames = {
     "upload", "dispatch",       "references",       "pose",    "integrate",    "global_shape", "local_shape",
-    "length", "collision",      "body_collision",   "self_interaction", "rebuild", "follow_hairs", "sleep"};
+    "length", "collision",      "body_collision",   "self_interaction", "rebuild", "interpolate", "follow_hairs",
+    "sleep"};
 
 constexpr std::size_t stage_index(Stage s) { return static_cast<std::size_t>(s); }
 constexpr std::string_view stage_name(Stage s) { return kStageNames[stage_index(s)]; }

@@ -28,6 +28,10 @@ class FollowHairsAdapter final : public HairModel {
   std::span<const Vec4f> positions() const override { return positions_; }
   Backend backend() const override { return inner_->backend(); }
   std::optional<double> last_gpu_ms() const override { return inner_->last_gpu_ms(); }
+  // Of the guides: a follow hair moves with its guide.
+  std::size_t static_strands() const override { return inner_->static_strands(); }
+  const Groom* simulated_groom() const override { return inner_->simulated_groom(); }
+  std::span<const Vec4f> simulated_positions() const override { return inner_->simulated_positions(); }
 
  private:
   void rebuild();

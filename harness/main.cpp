@@ -107,6 +107,7 @@ struct CompareArgs {
   std::string models = ".*";
   bool models_given = false;
   std::vector<std::string> sets;   // --set, in order
+  std::vector<std::string> presets;  // --preset, in order (before every --set)
   std::vector<std::string> knobs;  // --knob (sweep only, which needs exactly one)
   int threads = 0;
   std::string out;
@@ -178,6 +179,12 @@ void select_knob_models(CompareArgs& a) {
 
 // The checks and lookups behind compare's and sweep's options, once CLI11 has read them.
 void prepare_compare(CompareArgs& a, bool sweep) {
+  for (const std::string& name : a.presets) {
+    const Preset* p = find_preset(name);
+    if (!p) throw InputError("--preset", name, "unknown preset (see `hairbench list presets`)");
+    for (const PresetValue& v : p->values)
+      a.run.overrides.push_back({std::string(v.model), std::string(v.param), v.value});
+  }
   for (const std::string& set : a.sets) {
     ParamOverride o = parse_param_override(set);
     check_param_override(o);
@@ -589,7 +596,16 @@ bool shard_papers(ReproduceOptions& opt, const ReproduceShard& rs) {
 }
 
 int cmd_list(const std::string& what) {
-  if (what.empty()) throw InputError("arguments", "list", "expected `list models`, `list scenarios` or `list devices`");
+  if (what.empty())
+    throw InputError("arguments", "list", "expected `list models`, `list scenarios`, `list presets` or `list devices`");
+  if (what == "presets") {
+    for (const Preset& p : presets()) {
+      std::printf("%-18s %s\n", std::string(p.name).c_str(), std::string(p.summary).c_str());
+      for (const PresetValue& v : p.values)
+        std::printf("%-18s   --set %s.%s=%g\n", "", std::string(v.model).c_str(), std::string(v.param).c_str(), v.value);
+    }
+    return 0;
+  }
   if (what == "models") {
     int width = 0;
     for (const ModelInfo& m : model_registry()) width = std::max(width, static_cast<int>(m.name.size()));
@@ -620,7 +636,8 @@ int cmd_list(const std::string& what) {
 #endif
     return 0;
   }
-  throw InputError("arguments", "list " + what, "expected `list models`, `list scenarios` or `list devices`");
+  throw InputError("arguments", "list " + what,
+                   "expected `list models`, `list scenarios`, `list presets` or `list devices`");
 }
 
 // --frames, --threads, --keep-every: a whole number in [lo, hi]. The one place numbers
@@ -733,6 +750,10 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
   sub.add_option("--set", a.sets, "parameter override; MODEL may be * for every model that\nhas NAME; repeatable")
       ->type_name("MODEL.NAME=VALUE")
       ->allow_extra_args(false);
+  sub.add_option("--preset", a.presets,
+                 "a paper's force law as written (list presets), applied\nbefore --set; repeatable")
+      ->type_name("NAME")
+      ->allow_extra_args(false);
   sub.add_option("--out", a.out, "the report's directory")->type_name("DIR")->capture_default_str();
   sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write the report only");
   sub.add_option("--device", a.run.device,
@@ -821,7 +842,7 @@ int run(int argc, char** argv) {
 
   std::string list_what;
   CLI::App* list = app.add_subcommand("list", kListHelp);
-  list->add_option("WHAT", list_what, "what to list")->type_name("models|scenarios|devices");
+  list->add_option("WHAT", list_what, "what to list")->type_name("models|scenarios|presets|devices");
 
   CompareArgs compare_args, sweep_args;
   CLI::App* compare = app.add_subcommand("compare", kCompareHelp);

@@ -236,6 +236,9 @@ struct Lane {
   bool device_reference = false;
   std::span<const StrandMetrics> strands{};
   int kept_frame = -1;
+  // The nodes a model draws the groom from (HairModel::simulated_groom), whose edges the
+  // stretched verdict reads.
+  std::optional<metrics::RestInfo> nodes = std::nullopt;
 };
 
 // The lockstep run of one scenario, step by step: make the lanes (the reference first),
@@ -434,6 +437,8 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   }
   r.strands = sc_.groom.strand_count();
   r.vertices = sc_.groom.vertex_count();
+  r.static_strands = lane.model->static_strands();
+  if (const Groom* nodes = lane.model->simulated_groom()) lane.nodes.emplace(*nodes);
   r.dt = sc_.dt;
   r.settle_from = sc_.settle_from;
   r.params = params_json(params, sc_.groom);
@@ -613,8 +618,11 @@ void LockstepRun::measure(const FrameInput& in) {
         case kJaggedness: v[kJaggedness] = metrics::jaggedness(rest_, p); break;
         case kLength:
           length[i] = metrics::length_error(rest_, p);
-          guide_length[i] =
-              guides_ ? metrics::length_error(*guides_, p.first(sc_.guides.vertex_count())) : length[i];
+          if (lanes_[i].nodes)
+            guide_length[i] = metrics::length_error(*lanes_[i].nodes, lanes_[i].model->simulated_positions());
+          else
+            guide_length[i] =
+                guides_ ? metrics::length_error(*guides_, p.first(sc_.guides.vertex_count())) : length[i];
           break;
         case kRestShape: v[kRestShape] = metrics::rest_shape_error(rest_, p, in.head); break;
         // With follow hairs, the guides' and the follow hairs' apart; the larger is the
@@ -803,7 +811,7 @@ void LockstepRun::extend_settle(int frames) {
 
 verdict::Stretch LockstepRun::stretch_of(const Lane& l) const {
   verdict::Stretch s = l.stretch.result();
-  const Groom& simulated = sc_.follow ? sc_.guides : sc_.groom;
+  const Groom& simulated = l.nodes ? *l.nodes->groom : sc_.follow ? sc_.guides : sc_.groom;
   if (s.frames_above > 0 && s.worst_strand < simulated.strand_count() && s.worst_edge >= 2 &&
       s.worst_edge < simulated.strand_size(s.worst_strand)) {
     const Vec4f* p = simulated.positions.data() + simulated.strand_begin(s.worst_strand);

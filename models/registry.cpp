@@ -3,6 +3,7 @@
 #include "models/halen2007/cascade_settings.h"
 #include "models/halen2007/forest_settings.h"
 #include "models/halen2007/fused/model.h"
+#include "models/halen2007/nodes_model.h"
 #include "models/halen2007/reference/cascade.h"
 #include "models/halen2007/reference/forest.h"
 #include "models/halen2007/reference/spring.h"
@@ -20,6 +21,21 @@
 #include <vector>
 
 namespace hairbench {
+
+namespace {
+
+// Halén & Wester's models simulate `nodes` nodes a strand and draw the groom from them
+// (models/halen2007/nodes_model.h); their step bounds are taken on those nodes.
+std::unique_ptr<HairModel> at_nodes(std::unique_ptr<HairModel> inner, const halen::NodeTraits& traits,
+                                    const ModelContext& c) {
+  return std::make_unique<halen::NodesModel>(std::move(inner), traits, c);
+}
+template <halen::BoundFn bound, const halen::NodeTraits& traits>
+halen::StepBound bound_at_nodes(const Groom& g, const ParamSet& p, const Vec3f& gravity) {
+  return halen::bound_at_nodes(bound, traits, g, p, gravity);
+}
+
+}  // namespace
 
 std::span<const ModelInfo> model_registry() {
   static const std::vector<ModelInfo> models = {
@@ -55,39 +71,39 @@ std::span<const ModelInfo> model_registry() {
       {.name = "halen_spring",
        .summary = "Halén & Wester 2007 §4.4: springs to head-fixed reference nodes, tilt-weakened (§5.9); fused SoA kernel",
        .params = halen_spring::kParams,
-       .make = [](const ModelContext& c) { return halen_fused::make(halen_fused::Model::Spring, c); },
-       .step_bound = halen::spring_bound},
+       .make = [](const ModelContext& c) { return at_nodes(halen_fused::make(halen_fused::Model::Spring, c), halen::kSpringNodes, c); },
+       .step_bound = bound_at_nodes<halen::spring_bound, halen::kSpringNodes>},
       {.name = "halen_cascade",
        .summary = "Halén & Wester 2007 §4.3: cascading tangent spaces with up/down reference nodes (§5.9); fused SoA kernel",
        .params = halen_cascade::kParams,
-       .make = [](const ModelContext& c) { return halen_fused::make(halen_fused::Model::Cascade, c); },
-       .step_bound = halen::cascade_bound},
+       .make = [](const ModelContext& c) { return at_nodes(halen_fused::make(halen_fused::Model::Cascade, c), halen::kCascadeNodes, c); },
+       .step_bound = bound_at_nodes<halen::cascade_bound, halen::kCascadeNodes>},
       {.name = "halen_forest",
        .summary = "Halén & Wester 2007 §4.2 (Di Giacomo et al. 2001): joint angles, x-primary axes (§5.9); fused SoA kernel",
        .params = halen_forest::kParams,
-       .make = [](const ModelContext& c) { return halen_fused::make(halen_fused::Model::Forest, c); },
-       .step_bound = halen::forest_bound},
+       .make = [](const ModelContext& c) { return at_nodes(halen_fused::make(halen_fused::Model::Forest, c), halen::kForestNodes, c); },
+       .step_bound = bound_at_nodes<halen::forest_bound, halen::kForestNodes>},
       {.name = "halen_spring_ref",
        .summary = "halen_spring as one stage at a time over all strands with the per-strand kernels",
        .params = halen_spring::kParams,
-       .make = [](const ModelContext& c) { return halen_spring::make(c); },
+       .make = [](const ModelContext& c) { return at_nodes(halen_spring::make(c), halen::kSpringNodes, c); },
        .reference_of = "halen_spring",
-       .step_bound = halen::spring_bound},
+       .step_bound = bound_at_nodes<halen::spring_bound, halen::kSpringNodes>},
       {.name = "halen_cascade_ref",
        .summary = "halen_cascade as one stage at a time over all strands with the per-strand kernels",
        .params = halen_cascade::kParams,
-       .make = [](const ModelContext& c) { return halen_cascade::make(c); },
+       .make = [](const ModelContext& c) { return at_nodes(halen_cascade::make(c), halen::kCascadeNodes, c); },
        .reference_of = "halen_cascade",
-       .step_bound = halen::cascade_bound},
+       .step_bound = bound_at_nodes<halen::cascade_bound, halen::kCascadeNodes>},
       {.name = "halen_forest_ref",
        .summary = "halen_forest as one stage at a time over all strands with the per-strand kernels",
        .params = halen_forest::kParams,
-       .make = [](const ModelContext& c) { return halen_forest::make(c); },
+       .make = [](const ModelContext& c) { return at_nodes(halen_forest::make(c), halen::kForestNodes, c); },
        .reference_of = "halen_forest",
        // The fused forest composes the joint rotations in another order and takes sin/cos
        // from a polynomial (kernels/simd/vec_math.h).
        .reference_tolerance = 1e-5,
-       .step_bound = halen::forest_bound},
+       .step_bound = bound_at_nodes<halen::forest_bound, halen::kForestNodes>},
       // Plante, Cani & Poulin 2001 (models/plante2001)
       {.name = "plante_wisp",
        .summary = "Plante, Cani & Poulin 2001: layered wisps (skeleton, envelope, strands) with anisotropic interactions (§3-5)",
@@ -120,6 +136,46 @@ std::span<const ModelInfo> model_registry() {
 #endif
   };
   return models;
+}
+
+std::span<const Preset> presets() {
+  // Each value for a model and its reference implementation.
+  auto both = [](std::string_view model, std::string_view ref, std::vector<std::pair<std::string_view, double>> v) {
+    std::vector<PresetValue> out;
+    for (std::string_view m : {model, ref})
+      for (const auto& [param, value] : v) out.push_back({m, param, value});
+    return out;
+  };
+  // §4.2 as written (forest_settings.h): gravity bends the strand, J ≈ mI, the head's
+  // angular acceleration in the first joint, no drag, an undamped penalty.
+  const std::vector<PresetValue> forest =
+      both("halen_forest", "halen_forest_ref",
+           {{"gravity_compensation", 0}, {"inertia", 0}, {"root_angular_acceleration", 1}, {"drag", 0},
+            {"collision_damping", 0}});
+  // §4.3 as written (cascade_settings.h): reference nodes fixed during the step, and
+  // B = N × T_parent.
+  const std::vector<PresetValue> cascade =
+      both("halen_cascade", "halen_cascade_ref", {{"reactions", 0}, {"frames", 0}});
+  std::vector<PresetValue> thesis = forest;
+  thesis.insert(thesis.end(), cascade.begin(), cascade.end());
+  static const std::vector<Preset> all = {
+      {"halen2007", "Halén & Wester 2007's forest (§4.2) and cascade (§4.3) as the thesis writes them", thesis},
+      {"halen2007_forest",
+       "halen_forest as §4.2 writes it: gravity uncompensated, J = mI, the head's angular acceleration in the "
+       "first joint, no drag, an undamped penalty",
+       forest},
+      {"halen2007_cascade", "halen_cascade as §4.3 writes it: fixed reference nodes, B = N x T_parent", cascade},
+      // §3.2 as written (plante2001/settings.h): angle springs between segments.
+      {"plante2001", "plante_wisp's bending springs as §3.2 writes them (bending=0)",
+       both("plante_wisp", "plante_wisp_ref", {{"bending", 0}})},
+  };
+  return all;
+}
+
+const Preset* find_preset(std::string_view name) {
+  for (const Preset& p : presets())
+    if (p.name == name) return &p;
+  return nullptr;
 }
 
 const ModelInfo* find_model(std::string_view name) {

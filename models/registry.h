@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace hairbench {
 
@@ -41,6 +42,22 @@ struct ModelInfo {
 };
 
 std::span<const ModelInfo> model_registry();
+
+// A paper's force law as written, where a model's default differs from it: named
+// parameter values (`hairbench compare --preset NAME`), applied before any --set.
+struct PresetValue {
+  std::string_view model;
+  std::string_view param;
+  double value;
+};
+struct Preset {
+  std::string_view name;
+  std::string_view summary;
+  std::vector<PresetValue> values;
+};
+std::span<const Preset> presets();
+// nullptr if there is no such preset.
+const Preset* find_preset(std::string_view name);
 // nullptr if there is no such model.
 const ModelInfo* find_model(std::string_view name);
 // The reference implementation of `model` (the entry whose reference_of names it), or

@@ -317,7 +317,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
                        {"model", r.model},
                        {"backend", r.backend},
                        {"metrics_on", r.metrics_on},
-                       {"groom", {{"strands", r.strands}, {"vertices", r.vertices}}},
+                       {"groom", {{"strands", r.strands}, {"vertices", r.vertices}, {"static_strands", r.static_strands}}},
                        {"frames", r.frames},
                        {"frames_run", done},
                        {"dt", r.dt},

@@ -25,6 +25,7 @@ struct RunRecord {
   std::string device;  // the GPU a GPU model ran on (run "device"; context "devices")
   std::string metrics_on = "host";  // where the per-frame metrics were computed: "host" or "device"
   std::size_t strands = 0, vertices = 0;
+  std::size_t static_strands = 0;  // held rigid with the head (HairModel::static_strands)
   int frames = 0;  // frames requested
   double dt = 0.0;
   double settle_from = 0.0;

@@ -74,7 +74,7 @@ TEST(Cli, VersionNamesTheBuiltCommit) {
 TEST(Cli, HelpNamesEveryOption) {
   const std::vector<std::string> run_options = {"--scenario", "--models",  "--reference", "--frames", "--threads",
                                                 "--set",      "--out",     "--no-charts", "--device", "--no-skip",
-                                                "--shard",    "--plan",    "--costs"};
+                                                "--shard",    "--plan",    "--costs",     "--preset"};
   std::vector<std::string> sweep_options = run_options;
   sweep_options.push_back("--knob");
   struct Help {
@@ -83,13 +83,13 @@ TEST(Cli, HelpNamesEveryOption) {
   };
   const std::vector<Help> cases = {
       {"", {"--help", "--version", "list", "compare", "sweep", "stress", "merge", "reproduce"}, {"--frames"}},
-      {"list", {"--help", "models|scenarios|devices"}, {"--out"}},
+      {"list", {"--help", "models|scenarios|presets|devices"}, {"--out"}},
       {"compare", run_options, {"--knob", "--quick"}},
       {"sweep", sweep_options, {"--quick", "--keep-every"}},
       {"stress",
        {"--models", "--base", "--axes", "--keep-every", "--quick", "--threads", "--out", "--no-charts", "--shard",
         "--plan", "--costs"},
-       {"--scenario", "--set", "--knob"}},
+       {"--scenario", "--set", "--knob", "--preset"}},
       {"merge", {"OUT_DIR", "REPORT.json", "--mix-machines", "--no-charts"}, {"--frames", "--models", "--costs"}},
       {"reproduce",
        {"han2012", "halen2007", "plante2001", "all", "--frames", "--threads", "--device", "--out", "--shard", "--plan"},
@@ -151,6 +151,36 @@ TEST(Cli, ListsModelsAndScenarios) {
   EXPECT_EQ(scenarios.code, 0);
   for (const char* s : {"idle", "nod", "shake", "spin_fast", "walk", "tilt_upside_down", "wind_gust", "ponytail"})
     EXPECT_NE(scenarios.out.find(s), std::string::npos) << s;
+}
+
+// A preset stands for the --sets of a paper's force law as written (list presets prints
+// them): the report's parameters are the thesis cascade's, a --set after it still wins,
+// and an unknown preset is a one-line error naming the option.
+TEST(Cli, PresetsSetThePapersLawsAndAreListed) {
+  const hairbench::test::CliResult list = run_cli("list presets");
+  EXPECT_EQ(list.code, 0);
+  for (const char* p : {"halen2007", "halen2007_forest", "halen2007_cascade", "plante2001",
+                        "--set halen_cascade.reactions=0", "--set plante_wisp.bending=0"})
+    EXPECT_NE(list.out.find(p), std::string::npos) << p << "\n" << list.out;
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / "hairbench-cli-preset";
+  std::filesystem::remove_all(out);
+  const hairbench::test::CliResult r =
+      run_cli("compare --scenario shake --models halen_cascade --frames 1 --no-charts --preset halen2007 "
+              "--set halen_cascade.frames=1 --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::ifstream in(out / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  bool found = false;
+  for (const auto& run : report["runs"]) {
+    if (run["model"] != "halen_cascade") continue;
+    found = true;
+    EXPECT_EQ(run["params"]["reactions"], 0.0);
+    EXPECT_EQ(run["params"]["frames"], 1.0) << "a --set after the preset wins";
+  }
+  EXPECT_TRUE(found);
+  const hairbench::test::CliResult bad = run_cli("compare --scenario shake --preset nope --frames 1 --no-charts");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.out.find("--preset: nope: unknown preset"), std::string::npos) << bad.out;
 }
 
 // The report names the commit the binary was built from, as recorded at build time (not

@@ -177,10 +177,13 @@ Scenario mohawk_without_substeps() {
   return sc;
 }
 
+// At 32 nodes, the short strands' sub-millimetre edges are simulated (at the default 8 their
+// nodes are centimetres apart and six substeps hold them).
 TEST(AutoSubsteps, KeepHalenSpringsEdgesOnTheMohawk) {
   const Scenario sc = mohawk_without_substeps();
   const ModelInfo& spring = *find_model("halen_spring");
-  const auto chosen = choose_substeps(spring, sc, resolve_params(spring, sc, {}), {});
+  const std::vector<ParamOverride> fine{{"halen_spring", "nodes", 32}};
+  const auto chosen = choose_substeps(spring, sc, resolve_params(spring, sc, fine), fine);
   ASSERT_TRUE(chosen);
   EXPECT_EQ(chosen->source, "auto");
   EXPECT_GT(chosen->value, 6);
@@ -194,8 +197,9 @@ TEST(AutoSubsteps, KeepHalenSpringsEdgesOnTheMohawk) {
   RunOptions opt;
   opt.models = {"halen_spring"};
   opt.probe = false;
+  opt.overrides = fine;
   EXPECT_EQ(run_scenario(sc, opt, pool).back().verdict.status, verdict::Status::ok);
-  opt.overrides = {{"halen_spring", "substeps", 6}};
+  opt.overrides = {{"halen_spring", "nodes", 32}, {"halen_spring", "substeps", 6}};
   EXPECT_EQ(run_scenario(sc, opt, pool).back().verdict.status, verdict::Status::stretched);
 }
 

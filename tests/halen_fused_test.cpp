@@ -122,7 +122,8 @@ TEST(HalenFused, IsaVariantsGiveTheSameBits) {
   }
 }
 
-// The stages of the references are reported, collisions skipped without colliders.
+// The stages of the references are reported, collisions skipped without colliders, and
+// the groom drawn from the simulated nodes (§5.5) as its own stage.
 TEST(HalenFused, StagesAreReported) {
   const Scenario sc = test::builtin("shake", 16);
   ThreadPool pool(2);
@@ -135,7 +136,8 @@ TEST(HalenFused, StagesAreReported) {
     std::map<std::string, bool> skipped;
     for (const auto& e : t.entries()) skipped[std::string(e.name)] = e.skipped;
     EXPECT_EQ(skipped, (std::map<std::string, bool>{
-                           {"references", false}, {"integrate", false}, {"length", false}, {"collision", true}}))
+                           {"references", false}, {"integrate", false}, {"length", false}, {"collision", true},
+                           {"interpolate", false}}))
         << name;
   }
   auto forest = test::make_named("halen_forest", sc, {}, pool);
@@ -143,7 +145,7 @@ TEST(HalenFused, StagesAreReported) {
   forest->step(frame_input(sc, 0), t);
   std::map<std::string, bool> skipped;
   for (const auto& e : t.entries()) skipped[std::string(e.name)] = e.skipped;
-  EXPECT_EQ(skipped, (std::map<std::string, bool>{{"pose", false}, {"integrate", false}}));
+  EXPECT_EQ(skipped, (std::map<std::string, bool>{{"pose", false}, {"integrate", false}, {"interpolate", false}}));
 }
 
 }  // namespace

@@ -2,18 +2,18 @@
 // and weakened downward springs).
 //
 // Stiffnesses are per unit node mass (s^-2), so the node mass m of L = mg/k cancels.
-// Each reference spring, with its reaction on the segment that carries its space, is half
-// of a torsion spring: the springs make no energy (to the twist the reaction leaves out,
-// below), and the rest state is stable at any strand length. They make a strand an elastic rod whose slowest mode, the strand turning
-// about its root, has a stiffness of about k (ℓ/L)^4 for segments ℓ of a strand L: quick
-// at the thesis's 4 and 8 nodes, slow at 16 (docs/limitations.md, "The cascade").
-// Defaults are chosen for real gravity, 25 cm strands of 16 vertices and 60 Hz frames:
-// k = 6000 s^-2 at the root falling quadratically past 20 cm, as stiff as explicit Verlet
-// at six substeps allows with a margin (the probe finds the rest state growing at
-// 30,000); downward springs at a quarter of the upward ones (§5.9); six edge
-// corrections; damping 0.1 per substep, which keeps the slow mode from swinging for
-// seconds after the head stops, and damps what the reaction leaves out (that a space's
-// twist also follows the segments above it): at 0.03 some crown strands start to swing.
+// Each reference spring, with its reaction on what places its reference node (the segment
+// that carries its space, and the twist of the spaces above it), is half of a torsion
+// spring: the springs are the negative gradient of their energy and make none
+// (kernels::cascade_accelerations). They make a strand an elastic rod whose slowest mode,
+// the strand turning about its root, has a stiffness of about k (ℓ/L)^4 for segments ℓ of
+// a strand L; the stiffness is given at the thesis's 8 nodes and scaled with the node
+// count (models/halen2007/nodes_model.h). Defaults are chosen for real gravity, 25 cm
+// strands and 60 Hz frames: k = 6000 s^-2 at the root falling quadratically past 20 cm;
+// downward springs at a quarter of the upward ones (§5.9); six edge corrections; damping
+// 0.03 per sixth of a frame (11/s: the thesis gives Eq. 4.1's k no value), under which
+// the hair comes back to its style within seconds of the head stopping; at 0.1 the slow
+// mode creeps (docs/limitations.md, "The cascade").
 #pragma once
 
 #include "core/params.h"
@@ -22,9 +22,12 @@
 
 namespace hairbench::halen_cascade {
 
-inline constexpr std::array<ParamSpec, 9> kParams{{
-    {"damping", 0.1, 0.0, 1.0, false,
-     "fraction of velocity removed per substep in Verlet (Eq. 4.1: k = 1 - damping)"},
+inline constexpr std::array<ParamSpec, 10> kParams{{
+    {"nodes", 8, 2, 64, true,
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5); stiffness is given at 8 nodes and scales as ((nodes - 1) / 7)^4"},
+    {"damping", 0.03, 0.0, 1.0, false,
+     "fraction of velocity removed per sixth of a frame in Verlet (Eq. 4.1: k = 1 - damping), taken per "
+     "substep as the same per frame at any substep count"},
     {"stiffness", 6000.0, 0.0, 1e6, false,
      "k: upward reference spring strength at the root per unit node mass, s^-2 (§4.3, §5.9)"},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
@@ -33,7 +36,7 @@ inline constexpr std::array<ParamSpec, 9> kParams{{
     {"down_fraction", 0.25, 0.0, 1.0, false,
      "downward reference springs' strength as a fraction of the upward ones (§5.9; 1 = equal)"},
     {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep"},
-    {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
+    {"substeps", 6, 1, 1024, true, "solver passes per frame; the head is interpolated between them"},
     {"reactions", 1, 0, 1, true,
      "1: each reference spring pushes back on the segment that carries its space (the torsion spring "
      "§4.3 says the reference nodes simulate); 0: the reference nodes are fixed during the step"},

@@ -1,14 +1,15 @@
 // Parameters of Halén & Wester 2007's interactive forest model (§4.2 after Di Giacomo et
 // al. 2001, with §5.9's axis fix and stiffness falloff).
 //
-// Joint stiffness and damping are per unit inertia (s^-2 and s^-1). Defaults are chosen
-// for real gravity, 25 cm strands of 16 vertices and 60 Hz frames. A joint's spring acts
-// on its segment and, with the opposite sign, on the parent (Eq. 4.2.3); relative to the
-// parent (Eq. 4.2.5) the joints then see a discrete Laplacian of the spring torques, whose
-// slowest mode on n joints is about (π / 2n)² of k: 16 nodes need k in the thousands for
-// the strand to swing back within a second. Its fastest mode, about 4k, bounds the
-// explicit Euler step of Eq. 4.2.6 (v ≥ 4k dt, and 4 v dt < 2): twelve substeps with
-// v = 120 s^-1.
+// Joint stiffness and damping are per unit inertia (s^-2 and s^-1), given at 8 nodes and
+// scaled as ((nodes - 1) / 7)^2 (models/halen2007/nodes_model.h). Defaults are chosen for
+// real gravity, 25 cm strands and 60 Hz frames. A joint's spring acts on its segment and,
+// with the opposite sign, on the parent (Eq. 4.2.3); relative to the parent (Eq. 4.2.5)
+// the joints then see a discrete Laplacian of the spring torques, whose slowest mode on n
+// joints is about (π / 2n)² of k. The defaults are the material that k = 5000 s^-2 and
+// v = 120 s^-1 made of 16-vertex strands, carried to 8 nodes (× (7/15)²). The fastest
+// mode, about 4k, bounds the explicit Euler step of Eq. 4.2.6 (v ≥ 4k dt, and 4 v dt < 2):
+// 3 substeps at 8 nodes, under the default twelve.
 //
 // Five defaults are not §4.2's; each is a parameter, and
 //   --set halen_forest.gravity_compensation=0 --set halen_forest.inertia=0
@@ -27,7 +28,7 @@
 // head's angular acceleration twice (on `shake` the hair then never settles).
 //
 // The joint damping v reaches a strand's slowest swing as v (π / 2n)², 0.3 s^-1 at 32
-// vertices, so finer strands swing on for many seconds: `drag` damps each segment's
+// vertices unscaled, so finer strands swing on for many seconds: `drag` damps each segment's
 // rotation relative to the head directly, at any segment count. A penalty force on a
 // segment's end turns that segment alone while its parents move the end, a coupling that
 // is not the gradient of an energy, and an undamped penalty returns all it stores:
@@ -44,10 +45,12 @@
 
 namespace hairbench::halen_forest {
 
-inline constexpr std::array<ParamSpec, 13> kParams{{
-    {"joint_stiffness", 5000.0, 0.0, 1e6, false,
+inline constexpr std::array<ParamSpec, 14> kParams{{
+    {"nodes", 8, 2, 64, true,
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5); joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2"},
+    {"joint_stiffness", 1100.0, 0.0, 1e6, false,
      "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2"},
-    {"joint_damping", 120.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},
+    {"joint_damping", 26.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
     {"falloff_scale", 5.0, 0.0, 1e4, false,
      "c of §5.9, 1/m: the strength is k up to L = 1/c from the root, then falls as (L c)^-a"},

@@ -17,9 +17,12 @@
 
 namespace hairbench::halen_spring {
 
-inline constexpr std::array<ParamSpec, 7> kParams{{
+inline constexpr std::array<ParamSpec, 8> kParams{{
+    {"nodes", 8, 2, 64, true,
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5)"},
     {"damping", 0.04, 0.0, 1.0, false,
-     "fraction of velocity removed per substep in Verlet (Eq. 4.1: k = 1 - damping)"},
+     "fraction of velocity removed per sixth of a frame in Verlet (Eq. 4.1: k = 1 - damping), taken per "
+     "substep as the same per frame at any substep count"},
     {"stiffness", 900.0, 0.0, 1e6, false,
      "k: spring strength at the root per unit node mass, s^-2 (§4.4, §5.9)"},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},

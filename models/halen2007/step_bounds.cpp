@@ -1,10 +1,14 @@
 #include "models/halen2007/step_bounds.h"
 
+#include "kernels/halen2007/reference/halen_kernels.h"
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <span>
+#include <vector>
 
 namespace hairbench::halen {
 namespace {
@@ -72,12 +76,83 @@ StepBound spring_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity) 
   return explicit_spring_bound(g, k, gravity, "k = " + num(k) + " s^-2");
 }
 
+double cascade_rest_stiffness(const Groom& g, const ParamSet& p) {
+  namespace k = kernels;
+  const auto frames = static_cast<k::CascadeFrames>(p.get_int("frames"));
+  const bool reactions = p.get_int("reactions") != 0;
+  double largest = 0.0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    const std::size_t n = g.strand_size(s), r = g.strand_region[s];
+    const auto rest = std::span(g.positions).subspan(g.strand_begin(s), n);
+    std::vector<float> inv(n), ku(n), kd(n), lift(n), lever(n), twist(n);
+    std::vector<int> base(n);
+    std::vector<k::Mat3f> rest_space(n), space(n);
+    std::vector<Vec3f> up(n), down(n), plus(n), minus(n);
+    k::cascade_setup(rest, static_cast<float>(p.get("stiffness", r)), static_cast<float>(p.get("falloff_scale", r)),
+                     p.get_int("falloff_exponent", r), static_cast<float>(p.get("down_fraction", r)), frames, inv, ku,
+                     kd, lift, base, lever, rest_space, up, down);
+    const k::CascadeStrand cs{inv, ku, kd, lift, base, lever, up, down};
+    float shortest = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 1; i < n; ++i) shortest = std::min(shortest, (rest[i] - rest[i - 1]).head<3>().norm());
+    if (!(shortest > 0.0f)) continue;
+    // Power iteration on v -> -P J P v, J the springs' Jacobian at rest by central
+    // differences of displacements 1% of the shortest edge (the forces are float; smaller
+    // ones round), P the projection on the moves that keep every edge's length (root to
+    // tip, each vertex's move less its part along its edge relative to its parent's
+    // move): the edge corrections take the rest, so the springs' stiffness along the
+    // edges bounds no step.
+    const float eps = 0.01f * shortest;
+    std::vector<Vec3f> v(n);
+    for (std::size_t i = 0; i < n; ++i)
+      v[i] = Vec3f(std::sin(1.0f + i), std::cos(2.0f + 3.0f * i), std::sin(5.0f * i + 0.5f));
+    auto project = [&] {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (inv[i] == 0.0f) {
+          v[i].setZero();
+          continue;
+        }
+        if (i == 0) continue;
+        const Vec3f e = (rest[i] - rest[i - 1]).head<3>().normalized();
+        v[i] -= (v[i] - v[i - 1]).dot(e) * e;
+      }
+    };
+    std::vector<Vec4f> x(rest.begin(), rest.end());
+    double lambda = 0.0;
+    for (int it = 0; it < 40; ++it) {
+      project();
+      double norm = 0.0;
+      for (const Vec3f& vi : v) norm += vi.cast<double>().squaredNorm();
+      norm = std::sqrt(norm);
+      if (!(norm > 0.0)) break;
+      for (Vec3f& vi : v) vi /= static_cast<float>(norm);
+      auto forces = [&](float sign, std::vector<Vec3f>& out) {
+        for (std::size_t i = 0; i < n; ++i) x[i].head<3>() = rest[i].head<3>() + sign * eps * v[i];
+        k::tangent_spaces(x, rest_space[0], frames, base, space);
+        k::cascade_accelerations(x, space, cs, reactions, frames, Vec3f::Zero(), Vec3f::Zero(), twist, out);
+      };
+      forces(1.0f, plus);
+      forces(-1.0f, minus);
+      for (std::size_t i = 0; i < n; ++i) v[i] = (minus[i] - plus[i]) / (2.0f * eps);
+      project();
+      double applied = 0.0;
+      for (const Vec3f& vi : v) applied += vi.cast<double>().squaredNorm();
+      lambda = std::sqrt(applied);
+    }
+    largest = std::max(largest, lambda);
+  }
+  return largest;
+}
+
 StepBound cascade_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity) {
   const double k = max_param(g, p, "stiffness");
   double down = 0.0;
   for (std::size_t r = 0; r < g.region_names.size(); ++r) down = std::max(down, p.get("down_fraction", r));
   const double ratio = p.get_int("reactions") != 0 ? free_edges(g).ratio : 0.0;
   const double k_eff = k * (1.0 + down) * (1.0 + ratio) * (1.0 + ratio);
+  const double measured = cascade_rest_stiffness(g, p);
+  if (measured > k_eff)
+    return explicit_spring_bound(g, measured, gravity,
+                                 "the springs' stiffest mode at rest, " + num(measured) + " s^-2");
   return explicit_spring_bound(g, k_eff, gravity,
                                "k (1 + down)(1 + r)^2 = " + num(k_eff) + " s^-2, edge ratio r = " + num(ratio));
 }

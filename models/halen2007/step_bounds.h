@@ -41,7 +41,16 @@ StepBound spring_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity);
 // pushes back on the segment that carries the space through a lever l (f_A ~ |R| d / l,
 // kernels::cascade_accelerations), which multiplies the spring's stiffness on that
 // segment by up to (1 + d / l)^2.
+// The springs' reaction through the twist of the spaces (kernels::cascade_accelerations)
+// adds a stiffness that grows with the strand's curvature and with the springs beyond each
+// bend, which no closed form here bounds: the bound takes the larger of the above and the
+// stiffest mode of the springs at rest, found by power iteration on their Jacobian
+// (cascade_rest_stiffness); kOmegaStep's factor 2 below the stability limit covers the
+// bends that motion adds.
 StepBound cascade_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity);
+// The largest eigenvalue of the springs' stiffness (per unit mass, s^-2) over the strands
+// of g at rest with the head at identity, for the moves that keep the edges' lengths.
+double cascade_rest_stiffness(const Groom& g, const ParamSet& p);
 
 // halen_forest: explicit Euler of the joint angles (Eq. 4.2.6). The joints see a discrete
 // Laplacian of the spring torques whose fastest mode is about 4k; Euler keeps it when the

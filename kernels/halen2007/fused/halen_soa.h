@@ -53,8 +53,9 @@ inline constexpr std::size_t block_floats(Model m, int n) {  // Spring or Cascad
 // across frames.
 enum StateField : int { PX, PY, PZ, QX, QY, QZ, kStateFields };  // positions, previous positions
 inline constexpr std::size_t state_floats(int n) { return static_cast<std::size_t>(kStateFields * n) * kLanes; }
-// Per-thread scratch for a block of n vertices: the cascade's spring accelerations.
-inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(3 * n) * kLanes; }
+// Per-thread scratch for a block of n vertices: the cascade's spring accelerations, and
+// per space the springs' load on its twist, its bend's κ and whether the bend is taken.
+inline constexpr std::size_t scratch_floats(int n) { return static_cast<std::size_t>(8 * n) * kLanes; }
 
 // What a row (one vertex of every lane) holds: most rows are all free or all pinned.
 enum RowKind : std::uint8_t { kRowFree, kRowPinned, kRowMixed };

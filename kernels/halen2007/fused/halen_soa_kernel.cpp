@@ -28,6 +28,9 @@ struct Rows {
   int n;
   float *px, *py, *pz, *qx, *qy, *qz;  // positions, previous positions
   float *ax, *ay, *az;                 // the cascade's spring accelerations
+  // The cascade's twist (cascade_accelerations): per space the springs' load on its
+  // twist, its bend's κ, and 1 where the bend is taken (a space of its own, not folded back).
+  float *tw, *kx, *ky, *kz, *bend;
   const float* c;                      // the block's fields
   const RowKind* kind;
   const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
@@ -307,15 +310,16 @@ void reference_spring(const Rows& r, const Space& m, int i, int j, const float* 
   const float *pjx = r.px + oj, *pjy = r.py + oj, *pjz = r.pz + oj;
   alignas(64) float rx[W], ry[W], rz[W];  // R = -F, the elastic part's reaction
   alignas(64) float fx[W], fy[W], fz[W];  // its share f_A on the segment's first node
+  alignas(64) float dx[W], dy[W], dz[W];  // the reference node's offset M w
   LANES {
     const float a = lx[l], b = ly[l], c = lz[l];
-    const float dx = m.v[0][l] * a + (m.v[3][l] * b + m.v[6][l] * c);
-    const float dy = m.v[1][l] * a + (m.v[4][l] * b + m.v[7][l] * c);
-    const float dz = m.v[2][l] * a + (m.v[5][l] * b + m.v[8][l] * c);
+    dx[l] = m.v[0][l] * a + (m.v[3][l] * b + m.v[6][l] * c);
+    dy[l] = m.v[1][l] * a + (m.v[4][l] * b + m.v[7][l] * c);
+    dz[l] = m.v[2][l] * a + (m.v[5][l] * b + m.v[8][l] * c);
     const float kk = k[l];
-    const float ex = kk * (dx - (pix[l] - pjx[l]));
-    const float ey = kk * (dy - (piy[l] - pjy[l]));
-    const float ez = kk * (dz - (piz[l] - pjz[l]));
+    const float ex = kk * (dx[l] - (pix[l] - pjx[l]));
+    const float ey = kk * (dy[l] - (piy[l] - pjy[l]));
+    const float ez = kk * (dz[l] - (piz[l] - pjz[l]));
     const float kl = kk * lift[l];
     const bool free = iwi[l] != 0.0f;
     aix[l] = free ? aix[l] + (ex - kl * hgx) : aix[l];
@@ -325,12 +329,19 @@ void reference_spring(const Rows& r, const Space& m, int i, int j, const float* 
     ry[l] = -ey;
     rz[l] = -ez;
     const float dot = m.v[3][l] * rx[l] + (m.v[4][l] * ry[l] + m.v[5][l] * rz[l]);
-    fx[l] = (dot * dx - b * rx[l]) / lever[l];
-    fy[l] = (dot * dy - b * ry[l]) / lever[l];
-    fz[l] = (dot * dz - b * rz[l]) / lever[l];
+    fx[l] = (dot * dx[l] - b * rx[l]) / lever[l];
+    fy[l] = (dot * dy[l] - b * ry[l]) / lever[l];
+    fz[l] = (dot * dz[l] - b * rz[l]) / lever[l];
   }
   if (!reactions || j == 0) return;  // space 0 is the head's
   const float *bs = r.field(BS, j), *iwj = r.field(IW, j);
+  float* tw = r.tw + oj;
+  LANES {
+    // The spring's load on the twist of space j, N · (d × elastic) (reference_spring).
+    const float ex = -rx[l], ey = -ry[l], ez = -rz[l];
+    const float cx = dy[l] * ez - dz[l] * ey, cy = dz[l] * ex - dx[l] * ez, cz = dx[l] * ey - dy[l] * ex;
+    tw[l] = bs[l] != 0.0f ? tw[l] + (m.v[3][l] * cx + (m.v[4][l] * cy + m.v[5][l] * cz)) : tw[l];
+  }
   float *ajx = r.ax + oj, *ajy = r.ay + oj, *ajz = r.az + oj;
   LANES {
     const bool on = bs[l] != 0.0f && iwj[l] != 0.0f;
@@ -415,6 +426,89 @@ inline void own_space(const Space& parent, Space& cur, const float* ax, const fl
   }
 }
 
+// |P_i - P_{i-1}| of every lane, as the reference's norm.
+inline void edge_lengths(const Rows& r, int i, float* len) {
+  const int o = i * W;
+  LANES {
+    const float ex = r.px[o + l] - r.px[o - W + l], ey = r.py[o + l] - r.py[o - W + l],
+                ez = r.pz[o + l] - r.pz[o - W + l];
+    len[l] = std::sqrt(ex * ex + (ey * ey + ez * ez));
+  }
+}
+
+// p to row `to` and -p to row `from` (free vertices only) of the lanes in `on`: f = (q /
+// len) κ, the reference's push.
+inline void push_bend(const Rows& r, int to, int from, const float* q, const float* len, const float* kx,
+                      const float* ky, const float* kz, const int* on) {
+  const float *iwt = r.field(IW, to), *iwf = r.field(IW, from);
+  const int ot = to * W, of = from * W;
+  LANES {
+    const float s = q[l] / len[l];
+    const float fx = s * kx[l], fy = s * ky[l], fz = s * kz[l];
+    const bool t = on[l] != 0 && iwt[l] != 0.0f, f = on[l] != 0 && iwf[l] != 0.0f;
+    r.ax[ot + l] = t ? r.ax[ot + l] + fx : r.ax[ot + l];
+    r.ay[ot + l] = t ? r.ay[ot + l] + fy : r.ay[ot + l];
+    r.az[ot + l] = t ? r.az[ot + l] + fz : r.az[ot + l];
+    r.ax[of + l] = f ? r.ax[of + l] - fx : r.ax[of + l];
+    r.ay[of + l] = f ? r.ay[of + l] - fy : r.ay[of + l];
+    r.az[of + l] = f ? r.az[of + l] - fz : r.az[of + l];
+  }
+}
+
+// The springs' reaction through the spaces' twist (cascade_accelerations' twist_reactions),
+// tip to root: each bend's load, the springs' loads on the twist of the spaces from it
+// on, through the bend's two segments, j's and that of the space before it (almost always
+// j - 1; a lane whose j - 1 keeps its parent's space looks further back on its own).
+void twist_reactions(const Rows& r) {
+  alignas(64) float load[W] = {}, len[W], len_p[W];
+  alignas(64) int on[W], near[W], far[W];
+  for (int j = r.n - 1; j >= 1; --j) {
+    const int o = j * W;
+    const float *bend = r.bend + o, *kx = r.kx + o, *ky = r.ky + o, *kz = r.kz + o;
+    LANES {
+      load[l] += r.tw[o + l];
+      on[l] = static_cast<int>(bend[l] != 0.0f);
+    }
+    if (!any_lane(on)) continue;
+    edge_lengths(r, j, len);
+    push_bend(r, j, j - 1, load, len, kx, ky, kz, on);
+    if (j < 2) continue;
+    const float* bs = r.field(BS, j - 1);
+    edge_lengths(r, j - 1, len_p);
+    LANES {
+      const bool own = bs[l] == 1.0f && len_p[l] > 0.0f;
+      near[l] = static_cast<int>(on[l] != 0 && own);
+      far[l] = static_cast<int>(on[l] != 0 && !own);
+    }
+    push_bend(r, j - 1, j - 2, load, len_p, kx, ky, kz, near);
+    if (!any_lane(far)) continue;
+    for (int l = 0; l < W; ++l) {
+      if (!far[l]) continue;
+      auto own_len = [&](int q) {
+        const int a = q * W + l, b = a - W;
+        const float ex = r.px[a] - r.px[b], ey = r.py[a] - r.py[b], ez = r.pz[a] - r.pz[b];
+        return std::sqrt(ex * ex + (ey * ey + ez * ez));
+      };
+      int q = j - 1;
+      while (q >= 1 && !(r.field(BS, q)[l] == 1.0f && own_len(q) > 0.0f)) --q;
+      if (q < 1) continue;
+      const float s = load[l] / own_len(q);
+      const float fx = s * kx[l], fy = s * ky[l], fz = s * kz[l];
+      const int t = q * W + l, f = t - W;
+      if (r.field(IW, q)[l] != 0.0f) {
+        r.ax[t] += fx;
+        r.ay[t] += fy;
+        r.az[t] += fz;
+      }
+      if (r.field(IW, q - 1)[l] != 0.0f) {
+        r.ax[f] -= fx;
+        r.ay[f] -= fy;
+        r.az[f] -= fz;
+      }
+    }
+  }
+}
+
 // §4.3's first two steps and the springs' forces (tangent_spaces, cascade_accelerations):
 // every acceleration starts from gravity; then the tangent spaces from the root up, each
 // used at once for the springs it carries, the upward one of the vertex above it and the
@@ -427,6 +521,7 @@ void cascade_forces(const Rows& r, const Substep& s, const BlockParams& p, const
     r.ax[i] = gx;
     r.ay[i] = gy;
     r.az[i] = gz;
+    r.tw[i] = 0.0f;
   }
   // Space 0, the given one at the root: head rotation · its rest space. Then row j's
   // parent is sp[(j - 1) & 1] and its space goes to sp[j & 1].
@@ -481,9 +576,23 @@ void cascade_forces(const Rows& r, const Substep& s, const BlockParams& p, const
         cur.v[7][l] = on ? nz * b0 - nx * b2 : cur.v[7][l];
         cur.v[8][l] = on ? nx * b1 - ny * b0 : cur.v[8][l];
       }
+    // The bend between the parent's N and this space's, for the twist's part.
+    float *kx = r.kx + o, *ky = r.ky + o, *kz = r.kz + o, *bend = r.bend + o;
+    LANES {
+      const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
+      const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
+      const float px = parent.v[3][l], py = parent.v[4][l], pz = parent.v[5][l];
+      const float nx = cur.v[3][l], ny = cur.v[4][l], nz = cur.v[5][l];
+      const float c = px * nx + (py * ny + pz * nz);
+      kx[l] = (py * nz - pz * ny) / (1.0f + c);
+      ky[l] = (pz * nx - px * nz) / (1.0f + c);
+      kz[l] = (px * ny - py * nx) / (1.0f + c);
+      bend[l] = bs[l] == 1.0f && len > 0.0f && c > -0.999f ? 1.0f : 0.0f;
+    }
     if (j + 1 < n) up(cur, j);
     if (j >= 3) down(cur, j);
   }
+  if (p.reactions && p.transport) twist_reactions(r);
 }
 
 // The block's positions to the groom-ordered float4 array, for the lanes asked for (w:
@@ -509,6 +618,11 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
          scratch,
          scratch + rows,
          scratch + 2 * rows,
+         scratch + 3 * rows,
+         scratch + 4 * rows,
+         scratch + 5 * rows,
+         scratch + 6 * rows,
+         scratch + 7 * rows,
          b.data,
          b.rows};
   soa::StageClock clock(stage_ns);

@@ -149,10 +149,10 @@ void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, CascadeFrames
 
 namespace {
 // One reference spring of cascade_accelerations: vertex i towards the node `local` of
-// space j.
+// space j. Adds the spring's load on the twist of space j about its N to twist[j].
 void reference_spring(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
                       bool reactions, const Vec3f& head_gravity, std::size_t i, std::size_t j,
-                      const Vec3f& local, float k, std::span<Vec3f> acc) {
+                      const Vec3f& local, float k, std::span<float> twist, std::span<Vec3f> acc) {
   const Mat3f& m = space[j];
   const Vec3f d = m * local;
   // The stretch from the offsets (d and P_i - P_j, a segment or two long), not from the
@@ -165,19 +165,63 @@ void reference_spring(std::span<const Vec4f> pos, std::span<const Mat3f> space, 
   const Vec3f fa = (m.col(1).dot(r) * d - local.y() * r) / s.lever[j];
   if (s.inv_mass[j] != 0.0f) acc[j] += r - fa;
   if (s.inv_mass[static_cast<std::size_t>(a)] != 0.0f) acc[static_cast<std::size_t>(a)] += fa;
+  twist[j] += m.col(1).dot(d.cross(elastic));
+}
+
+// The springs' reaction through the twist of the spaces (CascadeFrames::Transport): space
+// j is its parent's carried by the smallest rotation from N_{j-1} to N_j, so every bend
+// between the root and segment j turns it about N_j (the frames' holonomy). A bend
+// between directions N_p and N (segments p and j, p the last one before j with a space of
+// its own; for j = 1 the root's given N), κ = N_p × N / (1 + N_p · N) half its curvature
+// binormal, turns the spaces from j on by -κ · dx / |e_j| for a move dx of P_j, κ · dx /
+// |e_j| for one of P_{j-1}, and likewise through e_p, κ · dx / |e_p| for P_{p-1} and
+// -κ · dx / |e_p| for P_p (the holonomy gradient of discrete elastic rods, Bergou et al.
+// 2008). twist[j] holds dE/dψ_j of the springs space j carries, summed tip
+// to root into each bend's load.
+void twist_reactions(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
+                     std::span<const float> twist, std::span<Vec3f> acc) {
+  const std::size_t n = pos.size();
+  auto own = [&](std::size_t j) {
+    return s.base[j] == static_cast<int>(j) - 1 && (xyz(pos[j]) - xyz(pos[j - 1])).norm() > 0.0f;
+  };
+  auto push = [&](std::size_t to, std::size_t from, const Vec3f& f) {
+    if (s.inv_mass[to] != 0.0f) acc[to] += f;
+    if (s.inv_mass[from] != 0.0f) acc[from] -= f;
+  };
+  float load = 0.0f;
+  for (std::size_t j = n - 1; j >= 1; --j) {
+    load += twist[j];
+    if (!own(j)) continue;
+    const Vec3f& nj = space[j].col(1);
+    const Vec3f& np = space[j - 1].col(1);
+    const float c = np.dot(nj);
+    if (!(c > -0.999f)) continue;  // folded back: the transport is undefined there
+    const Vec3f kappa = np.cross(nj) / (1.0f + c);
+    push(j, j - 1, (load / (xyz(pos[j]) - xyz(pos[j - 1])).norm()) * kappa);
+    std::size_t p = j - 1;
+    while (p >= 1 && !own(p)) --p;
+    if (p >= 1) push(p, p - 1, (load / (xyz(pos[p]) - xyz(pos[p - 1])).norm()) * kappa);
+  }
 }
 }  // namespace
 
 void cascade_accelerations(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
-                           bool reactions, const Vec3f& gravity, const Vec3f& head_gravity, std::span<Vec3f> acc) {
+                           bool reactions, CascadeFrames frames, const Vec3f& gravity, const Vec3f& head_gravity,
+                           std::span<float> twist, std::span<Vec3f> acc) {
   const std::size_t n = pos.size();
-  for (std::size_t i = 0; i < n; ++i) acc[i] = gravity;
+  for (std::size_t i = 0; i < n; ++i) {
+    acc[i] = gravity;
+    twist[i] = 0.0f;
+  }
   for (std::size_t j = 0; j < n; ++j) {
     if (j + 1 < n)
-      reference_spring(pos, space, s, reactions, head_gravity, j + 1, j, s.up_local[j + 1], s.k_up[j + 1], acc);
+      reference_spring(pos, space, s, reactions, head_gravity, j + 1, j, s.up_local[j + 1], s.k_up[j + 1], twist,
+                       acc);
     if (j >= 3)
-      reference_spring(pos, space, s, reactions, head_gravity, j - 2, j, s.down_local[j - 2], s.k_down[j - 2], acc);
+      reference_spring(pos, space, s, reactions, head_gravity, j - 2, j, s.down_local[j - 2], s.k_down[j - 2], twist,
+                       acc);
   }
+  if (reactions && frames == CascadeFrames::Transport) twist_reactions(pos, space, s, twist, acc);
 }
 
 void add_acceleration(std::span<Vec4f> pos, std::span<const Vec3f> acc, float dt) {

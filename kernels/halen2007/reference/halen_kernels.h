@@ -112,21 +112,29 @@ struct CascadeStrand {
 // zero-rest-length spring F = kL pulls its vertex P towards the reference node M w + O_T
 // (w its rest offset in the space), displaced against gravity, in two parts:
 //  - elastic, k (M w + O_T - P): the half of the torsion spring that §4.3 says the
-//    reference nodes simulate. With `reactions` it pushes back on the segment that
-//    carries the space, as a force R = -F at the reference node on a rigid segment
-//    (A = base[j], O = j): f_A = ((N·R) d - (N·d) R) / ℓ on A and R - f_A on O, d the
-//    node's offset from O, N the segment's direction and ℓ = lever[j], the split that
-//    gives the segment R's force and its torque across N. Without, the reference node
-//    is fixed during the step, as the thesis has it;
+//    reference nodes simulate. With `reactions` it pushes back on what places the node,
+//    so that the springs are the negative gradient of E = Σ k/2 |M w + O_T - P|² (they
+//    neither make nor take energy): on the segment that carries the space, as a force
+//    R = -F at the reference node on a rigid segment (A = base[j], O = j): f_A =
+//    ((N·R) d - (N·d) R) / ℓ on A and R - f_A on O, d the node's offset from O, N the
+//    segment's direction and ℓ = lever[j], the split that gives the segment R's force and
+//    its torque across N; and, with CascadeFrames::Transport, through the twist of the
+//    spaces about their N that every bend between the root and the space sets (the
+//    transported frames' holonomy). Without reactions the reference node is fixed during
+//    the step, as the thesis has it, and the springs are no gradient; with the thesis's
+//    Cross frames the twist's part is left out (their twist has no such gradient);
 //  - the displacement's share, k·lift·(-g_h) with g_h = `head_gravity`, gravity turned by
 //    the head (§4.4: the displaced position is "kept static in relation to the base"): at
-//    rest it carries the node's weight, mg, from the head.
+//    rest it carries the node's weight, mg, from the head; a constant force, the gradient
+//    of a linear potential.
 // Gravity is added here too, so that at rest it meets the displacement's share in one sum
 // (added to a position apart, the two would each round the position, and the roundings
 // of a moving strand do not cancel). Pinned vertices take nothing. Accumulated from
-// gravity, space by space, upward then downward.
+// gravity, space by space, upward then downward, then the twist's part tip to root.
+// `twist` is scratch of one float per vertex.
 void cascade_accelerations(std::span<const Vec4f> pos, std::span<const Mat3f> space, const CascadeStrand& s,
-                           bool reactions, const Vec3f& gravity, const Vec3f& head_gravity, std::span<Vec3f> acc);
+                           bool reactions, CascadeFrames frames, const Vec3f& gravity, const Vec3f& head_gravity,
+                           std::span<float> twist, std::span<Vec3f> acc);
 
 // p += dt² acc for the free vertices: gravity and the reference springs as the force term
 // of Verlet (Eq. 4.1), after verlet_integrate (run without gravity).

@@ -41,11 +41,13 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   for (std::size_t i = 0; i < nv; ++i) rest_.positions[i].w() = pos_[i].w() = prev_[i].w() = inv_mass_[i];
   space_ = rest_space_;
   acc_.assign(nv, Vec3f::Zero());
+  twist_.assign(nv, 0.0f);
 }
 
 std::size_t CascadeModel::state_bytes() const {
   return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
-         (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size() + inv_mass_.size() + lever_.size()) *
+         (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size() + inv_mass_.size() + lever_.size() +
+          twist_.size()) *
              sizeof(float) +
          base_.size() * sizeof(int) + (rest_space_.size() + space_.size()) * sizeof(kernels::Mat3f) +
          (up_local_.size() + down_local_.size() + acc_.size()) * sizeof(Vec3f);
@@ -97,8 +99,8 @@ void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt,
       k::tangent_spaces(strand(pos_, s), head_rotation * rest_space_[b], frames_, strand(base_, s), strand(space_, s));
       const k::CascadeStrand cs{strand(inv_mass_, s), strand(k_up_, s),   strand(k_down_, s),   strand(lift_, s),
                                 strand(base_, s),     strand(lever_, s),  strand(up_local_, s), strand(down_local_, s)};
-      k::cascade_accelerations(strand(pos_, s), strand(space_, s), cs, reactions_, in.gravity, head_gravity,
-                               strand(acc_, s));
+      k::cascade_accelerations(strand(pos_, s), strand(space_, s), cs, reactions_, frames_, in.gravity,
+                               head_gravity, strand(twist_, s), strand(acc_, s));
     });
   }
   {

@@ -51,6 +51,7 @@ class CascadeModel final : public HairModel {
   std::vector<int> base_;                           // rigid segment carrying each space
   std::vector<float> lever_;                        // ... and its rest length
   std::vector<Vec3f> acc_;                          // the springs' accelerations, this substep
+  std::vector<float> twist_;                        // the springs' loads on each space's twist
   kernels::CascadeFrames frames_ = kernels::CascadeFrames::Transport;
   bool reactions_ = true;
   std::vector<RegionSettings> region_;
