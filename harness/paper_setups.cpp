@@ -66,6 +66,8 @@ Scenario fig611_scenario(int strands, int nodes) {
   spec.strands = strands;
   spec.vertices_per_strand = nodes;
   sc.groom = generate_groom(spec, sc.head_radius, "fig611").groom;
+  // The Halén models simulate `nodes` nodes a strand of their own: the groom's.
+  sc.models["*"].base["nodes"] = nodes;
   return sc;
 }
 

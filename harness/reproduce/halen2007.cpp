@@ -430,6 +430,8 @@ Scenario motion_scenario(const std::string& name, int strands, int nodes) {
   sc.groom = std::move(g.groom);
   sc.region_params = std::move(g.region_params);
   for (auto& [model, o] : sc.models) o.regions.clear();
+  // The Halén models simulate `nodes` nodes a strand of their own: the groom's.
+  sc.models["*"].base["nodes"] = nodes;
   return sc;
 }
 
