@@ -32,10 +32,9 @@ struct StrandNodes {
   std::vector<bool> pinned;
 };
 
-StrandNodes strand_nodes(std::span<const Vec4f> rest, int count, bool root_node_only) {
+// `s`: the arc length of every vertex of `rest`.
+StrandNodes strand_nodes(std::span<const Vec4f> rest, std::span<const double> s, int count, bool root_node_only) {
   const std::size_t n = rest.size();
-  std::vector<double> s(n, 0.0);
-  for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (xyz(rest[i]) - xyz(rest[i - 1])).cast<double>().norm();
   std::size_t root_pins = 0;
   while (root_pins < n && rest[root_pins].w() == 0.0f) ++root_pins;
   std::vector<std::uint32_t> anchors;
@@ -118,7 +117,7 @@ NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static, bool ro
     const bool held = tied_static && n > 1 && rest[0].w() == 0.0f && rest[n - 1].w() == 0.0f &&
                       std::any_of(rest.begin(), rest.end(), [](const Vec4f& v) { return v.w() != 0.0f; });
     out.static_strands += held;
-    const StrandNodes sn = strand_nodes(rest, count, root_node_only);
+    const StrandNodes sn = strand_nodes(rest, s, count, root_node_only);
     const std::size_t first = out.nodes.positions.size();
     for (std::size_t j = 0; j < sn.arc.size(); ++j) {
       // A node on a vertex is that vertex, bit for bit; a node inside an edge takes the
