@@ -22,10 +22,20 @@ bool StrandSleep::begin_step(const FrameInput& in, bool enabled) {
 }
 
 void StrandSleep::observe(std::size_t s, std::span<const Vec4f> pos, std::span<const Vec4f> prev, float dt) {
-  const float limit = kRestSpeed * dt;
   float travel2 = 0.0f;
   for (std::size_t i = 0; i < pos.size(); ++i)
     travel2 = std::max(travel2, (pos[i].head<3>() - prev[i].head<3>()).squaredNorm());
+  observe_travel(s, travel2, dt);
+}
+
+void StrandSleep::observe_steps(std::size_t s, std::span<const Vec4f> step, float dt) {
+  float travel2 = 0.0f;
+  for (const Vec4f& d : step) travel2 = std::max(travel2, d.head<3>().squaredNorm());
+  observe_travel(s, travel2, dt);
+}
+
+void StrandSleep::observe_travel(std::size_t s, float travel2, float dt) {
+  const float limit = kRestSpeed * dt;
   if (travel2 < limit * limit) {
     if (++quiet_frames_[s] >= kQuietFrames) asleep_[s] = 1;
   } else {

@@ -28,6 +28,8 @@ class StrandSleep {
   // vertices' largest displacement over the last (sub)step of length dt. Touches only
   // strand s's entries, so strands may be observed in parallel.
   void observe(std::size_t s, std::span<const Vec4f> pos, std::span<const Vec4f> prev, float dt);
+  // The same from each vertex's step p - p_prev over that (sub)step (xyz).
+  void observe_steps(std::size_t s, std::span<const Vec4f> step, float dt);
   // The same, for models whose state is not positions: a bound on the strand's largest
   // vertex speed, m/s.
   void observe_speed(std::size_t s, float speed);
@@ -38,6 +40,9 @@ class StrandSleep {
   bool all_asleep() const { return all_asleep_; }
 
  private:
+  // The largest squared travel of the strand's vertices over a (sub)step of length dt.
+  void observe_travel(std::size_t s, float travel2, float dt);
+
   std::vector<std::uint8_t> asleep_;
   std::vector<std::int32_t> quiet_frames_;
   bool all_asleep_ = false;

@@ -1,6 +1,8 @@
 // Shared helpers for the model tests: load a built-in scenario, run it, read metrics.
 #pragma once
 
+#include <cstdio>
+
 #include "core/parallel.h"
 #include "harness/runner.h"
 #include "scenarios/scenario.h"
@@ -54,6 +56,13 @@ inline const RunRecord& find(const std::vector<RunRecord>& runs, const std::stri
   throw std::runtime_error("no run for " + model);
 }
 
+// A value for RecordProperty in 3 significant digits (std::to_string's six decimals show
+// 1e-7 as 0).
+inline std::string sci(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
 inline double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
 inline double mean_of(const std::vector<double>& v) {
   double s = 0.0;

@@ -42,4 +42,21 @@ void edge_length(std::span<Vec4f> pos, std::span<const float> rest_length);
 // does not leave the vertex inside another.
 void collide_spheres(std::span<Vec4f> pos, std::span<const Vec4f> world_spheres);
 
+// The same steps in step form: the Verlet state is each vertex's last step s = p - p_prev
+// (xyz; w unused) instead of p_prev, and every move of p (the integration, each edge
+// correction, each push out of a sphere, a pinned vertex following the head) is added to
+// s as it is made. The arithmetic is Verlet's, but the velocity no longer comes from the
+// difference of two positions rounded at the head's scale: there each position rounds by
+// up to half an ulp (3.7e-9 m at 0.1 m from the head's centre), a velocity error of
+// ulp / 2dt per step that does not shrink with dt. At a few dozen substeps a frame that
+// noise keeps a weakly held strand moving at ~1e-5 m (docs/limitations.md, "Float
+// rounding at many substeps"); in step form the positions still round, but as positions,
+// which the forces pull back.
+void follow_head_steps(std::span<Vec4f> pos, std::span<Vec4f> step, std::span<const Vec4f> rest,
+                       const Affine3f& head);
+void verlet_integrate_steps(std::span<Vec4f> pos, std::span<Vec4f> step, const Vec3f& gravity,
+                            const Wind& wind, bool wind_term, float damping, float dt);
+void edge_length_steps(std::span<Vec4f> pos, std::span<Vec4f> step, std::span<const float> rest_length);
+void collide_spheres_steps(std::span<Vec4f> pos, std::span<Vec4f> step, std::span<const Vec4f> world_spheres);
+
 }  // namespace hairbench::kernels

@@ -51,7 +51,8 @@ inline constexpr std::size_t block_floats(Model m, int n) {  // Spring or Cascad
 }
 // The state of a block (Spring or Cascade), n rows of kLanes floats each, persistent
 // across frames.
-enum StateField : int { PX, PY, PZ, QX, QY, QZ, kStateFields };  // positions, previous positions
+// Positions, and the spring model's previous positions or the cascade's last steps.
+enum StateField : int { PX, PY, PZ, QX, QY, QZ, kStateFields };
 inline constexpr std::size_t state_floats(int n) { return static_cast<std::size_t>(kStateFields * n) * kLanes; }
 // Per-thread scratch for a block of n vertices: the cascade's spring accelerations, and
 // per space the springs' load on its twist, its bend's κ and whether the bend is taken.

@@ -26,7 +26,9 @@ static_assert(W == soa::kRowLanes, "soa_rows.h takes rows of 16 lanes");
 // A block's rows: [component][vertex][lane].
 struct Rows {
   int n;
-  float *px, *py, *pz, *qx, *qy, *qz;  // positions, previous positions
+  // Positions; the spring model's previous positions, the cascade's last steps p - p_prev
+  // (the step form of strand_kernels.h).
+  float *px, *py, *pz, *qx, *qy, *qz;
   float *ax, *ay, *az;                 // the cascade's spring accelerations
   // The cascade's twist (cascade_accelerations): per space the springs' load on its
   // twist, its bend's κ, and 1 where the bend is taken (a space of its own, not folded back).
@@ -36,8 +38,8 @@ struct Rows {
   const float* field(int f, int i) const { return c + (static_cast<std::size_t>(f) * n + i) * W; }
 };
 
-// Pinned vertices follow the head (follow_head): prev = pos, pos = head · rest; the
-// cascade's, before its references read the moved roots. The pose is taken by value:
+// Pinned vertices follow the head (follow_head_steps): pos = head · rest, step = the
+// move; the cascade's, before its references read the moved roots. The pose is taken by value:
 // through a reference the compiler must assume the row stores may change it, and leaves
 // the lane loop scalar.
 void follow_head(const Rows& r, const soa::AffinePose h) {
@@ -52,9 +54,9 @@ void follow_head(const Rows& r, const soa::AffinePose h) {
       px[l] = pinned ? h.x(rx[l], ry[l], rz[l]) : x;
       py[l] = pinned ? h.y(rx[l], ry[l], rz[l]) : y;
       pz[l] = pinned ? h.z(rx[l], ry[l], rz[l]) : z;
-      qx[l] = pinned ? x : qx[l];
-      qy[l] = pinned ? y : qy[l];
-      qz[l] = pinned ? z : qz[l];
+      qx[l] = pinned ? px[l] - x : qx[l];
+      qy[l] = pinned ? py[l] - y : qy[l];
+      qz[l] = pinned ? pz[l] - z : qz[l];
     }
   }
 }
@@ -62,10 +64,11 @@ void follow_head(const Rows& r, const soa::AffinePose h) {
 // One substep's integration, row by row; every stage of the per-strand kernels reads only
 // its own row, so they run fused on a row while it is in registers: for the spring model
 // the reference node rigid with the head, lifted against gravity (§4.4, head_references)
-// and follow_head; then Verlet with damping (verlet_integrate) from vertex 1, and the
-// springs: the spring model's zero-rest-length pull towards its reference node
-// (add_spring_acceleration), p += (scale k dt²)(ref - p_start); the cascade's
-// accelerations from cascade_forces (add_acceleration), p += dt² a. The one read across
+// and follow_head; then Verlet with damping from vertex 1 (verlet_integrate; the
+// cascade's in step form, verlet_integrate_steps), and the springs: the spring model's
+// zero-rest-length pull towards its reference node (add_spring_acceleration),
+// p += (scale k dt²)(ref - p_start); the cascade's accelerations from cascade_forces
+// (add_acceleration), p and its step += dt² a. The one read across
 // rows is the wind term's, which sees vertex i-1 as Verlet left it, before its springs:
 // that row is kept aside. Rows whose lanes are all free or all pinned take no per-lane
 // selects.
@@ -129,12 +132,22 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
         ddy = (gy + (wy - dw * ty)) * dt2;
         ddz = (gz + (wz - dw * tz)) * dt2;
       }
-      nx = free ? (x + keep * (x - ox)) + ddx : nx;
-      ny = free ? (y + keep * (y - oy)) + ddy : ny;
-      nz = free ? (z + keep * (z - oz)) + ddz : nz;
-      ox = free ? x : ox;
-      oy = free ? y : oy;
-      oz = free ? z : oz;
+      if constexpr (kSpring) {
+        nx = free ? (x + keep * (x - ox)) + ddx : nx;
+        ny = free ? (y + keep * (y - oy)) + ddy : ny;
+        nz = free ? (z + keep * (z - oz)) + ddz : nz;
+        ox = free ? x : ox;
+        oy = free ? y : oy;
+        oz = free ? z : oz;
+      } else {  // verlet_integrate_steps
+        const float sx = keep * ox + ddx, sy = keep * oy + ddy, sz = keep * oz + ddz;
+        nx = free ? x + sx : nx;
+        ny = free ? y + sy : ny;
+        nz = free ? z + sz : nz;
+        ox = free ? sx : ox;
+        oy = free ? sy : oy;
+        oz = free ? sz : oz;
+      }
     }
     if constexpr (kWindy) {
       mx[l] = nx;
@@ -149,10 +162,14 @@ inline void integrate_row(const Rows& r, int i, const Integration& in, Moved& m)
       nx = free ? nx + c * (ax - ox) : nx;
       ny = free ? ny + c * (ay - oy) : ny;
       nz = free ? nz + c * (az - oz) : nz;
-    } else {
-      nx = free ? nx + dt2 * cx[l] : nx;
-      ny = free ? ny + dt2 * cy[l] : ny;
-      nz = free ? nz + dt2 * cz[l] : nz;
+    } else {  // add_acceleration: the position and its step
+      const float ddx = dt2 * cx[l], ddy = dt2 * cy[l], ddz = dt2 * cz[l];
+      nx = free ? nx + ddx : nx;
+      ny = free ? ny + ddy : ny;
+      nz = free ? nz + ddz : nz;
+      ox = free ? ox + ddx : ox;
+      oy = free ? oy + ddy : oy;
+      oz = free ? oz + ddz : oz;
     }
     px[l] = nx;
     py[l] = ny;
@@ -186,7 +203,9 @@ void integrate(const Rows& r, const Integration& in) {
   for (int i = 1; i < r.n; ++i) integrate_row<kModel, kWindy, false>(r, i, in, m);
 }
 
-// Edge length constraints (edge_length): odd edges, then even ones, mass-weighted.
+// Edge length constraints (edge_length): odd edges, then even ones, mass-weighted; kSteps:
+// each correction also to the vertices' steps (edge_length_steps).
+template <bool kSteps>
 void edge_length(const Rows& r) {
   for (int first : {1, 2})
     for (int i = first; i < r.n; i += 2) {
@@ -195,6 +214,8 @@ void edge_length(const Rows& r) {
       const float *aw = r.field(IW, i - 1), *bw = r.field(IW, i), *rl = r.field(RL, i);
       float *ax = r.px + o - W, *ay = r.py + o - W, *az = r.pz + o - W;
       float *bx = r.px + o, *by = r.py + o, *bz = r.pz + o;
+      float *sax = r.qx + o - W, *say = r.qy + o - W, *saz = r.qz + o - W;
+      float *sbx = r.qx + o, *sby = r.qy + o, *sbz = r.qz + o;
       LANES {
         const float wsum = aw[l] + bw[l];
         const float dx = bx[l] - ax[l], dy = by[l] - ay[l], dz = bz[l] - az[l];
@@ -202,12 +223,22 @@ void edge_length(const Rows& r) {
         const bool on = wsum != 0.0f && len > 0.0f;
         const float s = (len - rl[l]) / (len * wsum);
         const float cx = dx * s, cy = dy * s, cz = dz * s;
-        ax[l] = on ? ax[l] + aw[l] * cx : ax[l];
-        ay[l] = on ? ay[l] + aw[l] * cy : ay[l];
-        az[l] = on ? az[l] + aw[l] * cz : az[l];
-        bx[l] = on ? bx[l] - bw[l] * cx : bx[l];
-        by[l] = on ? by[l] - bw[l] * cy : by[l];
-        bz[l] = on ? bz[l] - bw[l] * cz : bz[l];
+        const float acx = aw[l] * cx, acy = aw[l] * cy, acz = aw[l] * cz;
+        const float bcx = bw[l] * cx, bcy = bw[l] * cy, bcz = bw[l] * cz;
+        ax[l] = on ? ax[l] + acx : ax[l];
+        ay[l] = on ? ay[l] + acy : ay[l];
+        az[l] = on ? az[l] + acz : az[l];
+        bx[l] = on ? bx[l] - bcx : bx[l];
+        by[l] = on ? by[l] - bcy : by[l];
+        bz[l] = on ? bz[l] - bcz : bz[l];
+        if constexpr (kSteps) {
+          sax[l] = on ? sax[l] + acx : sax[l];
+          say[l] = on ? say[l] + acy : say[l];
+          saz[l] = on ? saz[l] + acz : saz[l];
+          sbx[l] = on ? sbx[l] - bcx : sbx[l];
+          sby[l] = on ? sby[l] - bcy : sby[l];
+          sbz[l] = on ? sbz[l] - bcz : sbz[l];
+        }
       }
     }
 }
@@ -238,7 +269,9 @@ inline bool any_lane(const int* flags) {
 // spheres with several lanes of a row inside (on model 1; the spring model does no
 // worse).
 // The test accumulates into every lane with bitwise operations (no branch, no reduction
-// per sphere), so it stays one vector loop per sphere.
+// per sphere), so it stays one vector loop per sphere. kSteps: a lane's whole move is
+// added to its step (collide_spheres_steps).
+template <bool kSteps>
 void collide(const Rows& r, const Substep& s) {
   constexpr int kPasses = 4;
   for (int i = 0; i < r.n; ++i) {
@@ -260,6 +293,12 @@ void collide(const Rows& r, const Substep& s) {
     }
     LANES { hit[l] &= static_cast<int>(iw[l] != 0.0f); }
     if (!any_lane(hit)) continue;
+    alignas(64) float x0[W], y0[W], z0[W];  // the row before any pass
+    if constexpr (kSteps) {
+      std::memcpy(x0, px, sizeof x0);
+      std::memcpy(y0, py, sizeof y0);
+      std::memcpy(z0, pz, sizeof z0);
+    }
     for (int pass = 0; pass < kPasses; ++pass) {
       alignas(64) int moved[W];
       alignas(64) float ox[W], oy[W], oz[W];  // the row before this pass
@@ -287,6 +326,15 @@ void collide(const Rows& r, const Substep& s) {
       }
       const bool same = soa::same_bits(ox, px) && soa::same_bits(oy, py) && soa::same_bits(oz, pz);
       if (!any_lane(moved) || same) break;
+    }
+    if constexpr (kSteps) {
+      float *qx = r.qx + o, *qy = r.qy + o, *qz = r.qz + o;
+      LANES {
+        const bool on = hit[l] != 0;
+        qx[l] = on ? qx[l] + (px[l] - x0[l]) : qx[l];
+        qy[l] = on ? qy[l] + (py[l] - y0[l]) : qy[l];
+        qz[l] = on ? qz[l] + (pz[l] - z0[l]) : qz[l];
+      }
     }
   }
 }
@@ -656,13 +704,14 @@ void frame_impl(const Block& b, const BlockParams& p, const Frame& f, float* out
       integrate<kModel, false>(r, in);
     clock.lap(Stage::Integrate);
     feed.step();
+    constexpr bool kSteps = kModel == Model::Cascade;  // the step form (strand_kernels.h)
     for (int it = 0; it < p.length_iterations; ++it) {
-      edge_length(r);
+      edge_length<kSteps>(r);
       feed.step();
     }
     clock.lap(Stage::Length);
     if (s.sphere_count > 0) {
-      collide(r, s);
+      collide<kSteps>(r, s);
       clock.lap(Stage::Collision);
       feed.step();
     }

@@ -224,10 +224,14 @@ void cascade_accelerations(std::span<const Vec4f> pos, std::span<const Mat3f> sp
   if (reactions && frames == CascadeFrames::Transport) twist_reactions(pos, space, s, twist, acc);
 }
 
-void add_acceleration(std::span<Vec4f> pos, std::span<const Vec3f> acc, float dt) {
+void add_acceleration(std::span<Vec4f> pos, std::span<Vec4f> step, std::span<const Vec3f> acc, float dt) {
   const float dt2 = dt * dt;
-  for (std::size_t i = 0; i < pos.size(); ++i)
-    if (pos[i].w() != 0.0f) pos[i].head<3>() += dt2 * acc[i];
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    if (pos[i].w() == 0.0f) continue;
+    const Vec3f a = dt2 * acc[i];
+    pos[i].head<3>() += a;
+    step[i].head<3>() += a;
+  }
 }
 
 namespace {

@@ -136,9 +136,10 @@ void cascade_accelerations(std::span<const Vec4f> pos, std::span<const Mat3f> sp
                            bool reactions, CascadeFrames frames, const Vec3f& gravity, const Vec3f& head_gravity,
                            std::span<float> twist, std::span<Vec3f> acc);
 
-// p += dt² acc for the free vertices: gravity and the reference springs as the force term
-// of Verlet (Eq. 4.1), after verlet_integrate (run without gravity).
-void add_acceleration(std::span<Vec4f> pos, std::span<const Vec3f> acc, float dt);
+// p += dt² acc and the same to the vertex's step, for the free vertices: gravity and the
+// reference springs as the force term of Verlet (Eq. 4.1), after verlet_integrate_steps
+// (run without gravity; the step form of kernels/common/strand_kernels.h).
+void add_acceleration(std::span<Vec4f> pos, std::span<Vec4f> step, std::span<const Vec3f> acc, float dt);
 
 // ---- the interactive forest (§4.2, after Di Giacomo et al. 2001, and §5.9) ------------
 

@@ -208,9 +208,9 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
           row(st, soa::PH, i, l) = phi0[v];
           continue;
         }
-        for (int c = 0; c < 3; ++c) {  // the hair starts at rest
+        for (int c = 0; c < 3; ++c) {  // the hair starts at rest (the cascade's last steps: 0)
           row(st, soa::PX + c, i, l) = p0[c];
-          row(st, soa::QX + c, i, l) = p0[c];
+          row(st, soa::QX + c, i, l) = cascade ? 0.0f : p0[c];
         }
         row(d, soa::RX, i, l) = p0.x();
         row(d, soa::RY, i, l) = p0.y();
@@ -299,8 +299,8 @@ void HalenFusedModel::run_thread(int t) {
 }
 
 // StrandSleep::observe for every awake strand of this thread's blocks, with the previous
-// positions gathered from the block (the last substep's, as the reference's prev); the
-// forest's angular speeds for observe_speed.
+// positions gathered from the block (the last substep's, as the reference's prev; the
+// cascade's last steps for observe_steps); the forest's angular speeds for observe_speed.
 void HalenFusedModel::observe_sleep(int t, float dt) {
   const ThreadState& ts = threads_[static_cast<std::size_t>(t)];
   Vec4f* prev = prev_tmp_.data() + prev_tmp_.size() / threads_.size() * static_cast<std::size_t>(t);
@@ -327,7 +327,10 @@ void HalenFusedModel::observe_sleep(int t, float dt) {
         prev[v] = Vec4f(st[soa::QX * rows + k], st[soa::QY * rows + k], st[soa::QZ * rows + k], 0.0f);
       }
       const std::size_t n = static_cast<std::size_t>(b.n);
-      sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(strand_begin_[s], n), std::span<const Vec4f>(prev, n), dt);
+      if (model_ == Model::Cascade)
+        sleep_.observe_steps(s, std::span<const Vec4f>(prev, n), dt);
+      else
+        sleep_.observe(s, std::span<const Vec4f>(pos_).subspan(strand_begin_[s], n), std::span<const Vec4f>(prev, n), dt);
     }
   }
 }

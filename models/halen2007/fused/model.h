@@ -80,7 +80,7 @@ class HalenFusedModel final : public HairModel {
   std::size_t scratch_stride_ = 0;
   std::vector<float> backup_;  // per thread: a block's state, for its sleeping lanes
   std::size_t backup_stride_ = 0;
-  std::vector<Vec4f> prev_tmp_;  // per thread: one strand's previous positions
+  std::vector<Vec4f> prev_tmp_;  // per thread: one strand's previous positions (the cascade's steps)
   std::vector<kernels::halen_soa::Substep> substep_;
   std::vector<float> spheres_;        // per substep, x y z r per collider
   std::vector<float> spring_scale_;   // per region and substep: §4.4's tilt factor

@@ -13,7 +13,7 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   rest_ = rest;
   rest_length_ = rest_edge_lengths(rest);
   pos_ = rest.positions;
-  prev_ = rest.positions;
+  step_.assign(rest.vertex_count(), Vec4f::Zero());
   region_.clear();
   for (std::size_t r = 0; r < rest.region_names.size(); ++r)
     region_.push_back({static_cast<float>(params.get("damping", r)), params.get_int("length_iterations", r)});
@@ -38,14 +38,14 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   }
   // The cascade's own inverse masses (vertex 1 free): follow_head moves the vertices its
   // rest copy pins, the other kernels read the positions' w.
-  for (std::size_t i = 0; i < nv; ++i) rest_.positions[i].w() = pos_[i].w() = prev_[i].w() = inv_mass_[i];
+  for (std::size_t i = 0; i < nv; ++i) rest_.positions[i].w() = pos_[i].w() = inv_mass_[i];
   space_ = rest_space_;
   acc_.assign(nv, Vec3f::Zero());
   twist_.assign(nv, 0.0f);
 }
 
 std::size_t CascadeModel::state_bytes() const {
-  return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
+  return (rest_.positions.size() + pos_.size() + step_.size()) * sizeof(Vec4f) +
          (rest_length_.size() + k_up_.size() + k_down_.size() + lift_.size() + inv_mass_.size() + lever_.size() +
           twist_.size()) *
              sizeof(float) +
@@ -81,7 +81,7 @@ void CascadeModel::step(const FrameInput& in, StageTimes& times) {
   }
   if (calm) {
     StageTimer t(times, Stage::Sleep);
-    for_each_strand([&](std::size_t s, const RegionSettings&) { sleep_.observe(s, strand(pos_, s), strand(prev_, s), dt); });
+    for_each_strand([&](std::size_t s, const RegionSettings&) { sleep_.observe_steps(s, strand(step_, s), dt); });
     sleep_.end_observe();
   }
 }
@@ -95,7 +95,7 @@ void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt,
     StageTimer t(times, Stage::References);
     for_each_strand([&](std::size_t s, const RegionSettings&) {
       const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
-      k::follow_head(strand(pos_, s), strand(prev_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n), head);
+      k::follow_head_steps(strand(pos_, s), strand(step_, s), std::span<const Vec4f>(rest_.positions).subspan(b, n), head);
       k::tangent_spaces(strand(pos_, s), head_rotation * rest_space_[b], frames_, strand(base_, s), strand(space_, s));
       const k::CascadeStrand cs{strand(inv_mass_, s), strand(k_up_, s),   strand(k_down_, s),   strand(lift_, s),
                                 strand(base_, s),     strand(lever_, s),  strand(up_local_, s), strand(down_local_, s)};
@@ -107,14 +107,15 @@ void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt,
     StageTimer t(times, Stage::Integrate);
     for_each_strand([&](std::size_t s, const RegionSettings& r) {
       // Gravity is in the accelerations (cascade_accelerations).
-      k::verlet_integrate(strand(pos_, s), strand(prev_, s), Vec3f::Zero(), in.wind, plan.wind, r.damping, dt);
-      k::add_acceleration(strand(pos_, s), strand(acc_, s), dt);
+      k::verlet_integrate_steps(strand(pos_, s), strand(step_, s), Vec3f::Zero(), in.wind, plan.wind, r.damping, dt);
+      k::add_acceleration(strand(pos_, s), strand(step_, s), strand(acc_, s), dt);
     });
   }
   {
     StageTimer t(times, Stage::Length);
     for_each_strand([&](std::size_t s, const RegionSettings& r) {
-      for (int it = 0; it < r.length_iterations; ++it) k::edge_length(strand(pos_, s), strand(rest_length_, s));
+      for (int it = 0; it < r.length_iterations; ++it)
+        k::edge_length_steps(strand(pos_, s), strand(step_, s), strand(rest_length_, s));
     });
   }
   if (!plan.collision) {
@@ -126,7 +127,8 @@ void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt,
       const Vec3f center = collider_center(c, head);
       spheres_.emplace_back(center.x(), center.y(), center.z(), c.radius);
     }
-    for_each_strand([&](std::size_t s, const RegionSettings&) { k::collide_spheres(strand(pos_, s), spheres_); });
+    for_each_strand(
+        [&](std::size_t s, const RegionSettings&) { k::collide_spheres_steps(strand(pos_, s), strand(step_, s), spheres_); });
   }
 }
 

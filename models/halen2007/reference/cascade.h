@@ -57,7 +57,8 @@ class CascadeModel final : public HairModel {
   std::vector<RegionSettings> region_;
   int substeps_ = 1;
   StrandSleep sleep_;
-  std::vector<Vec4f> pos_, prev_;
+  std::vector<Vec4f> pos_;
+  std::vector<Vec4f> step_;  // each vertex's last step p - p_prev (the step form of strand_kernels.h)
   std::vector<Vec4f> spheres_;
 };
 
