@@ -29,6 +29,9 @@ namespace {
 
 using nlohmann::json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// "Slightly faster" (§6.1.2): the spring saves less than a third of the cascade's time.
+constexpr double kSlightly = 2.0 / 3.0;
 
 // Figure 6.1.1's strand counts (3², 5², 7², 11² strands) and node counts. The fits also
 // time the squares between, so that a slope rests on more than two points per half.
@@ -746,14 +749,44 @@ PaperResult reproduce_halen(const Ctx& c) {
     k.published = worst_pub;
     k.measured = worst;
     k.max = 1.0;
-    k.threshold_why = "faster at every point: every ratio below 1. How much faster (\"slightly\": the thesis's ratios "
-                      "reach " + num(worst_pub) + ") is the gap between two implementations on one CPU, a "
-                      "measurement, not tested";
+    k.threshold_why = "faster at every point: every ratio below 1 (how much faster is the next row's)";
     k.detail = "t(spring)/t(cascade) at 9, 25, 49, 121 strands, " + join(parts, "; ");
     const std::vector<double> cd8 = at_thesis_counts(t.at("cascade with reactions").at(8));
     k.why_differs = "the spring model is not faster at " + join(slow, "; ") +
                     " (our cascade with reactions, the default, takes " + num(cd8.back()) + " µs at 121×8)";
+
+    // "Slightly": the same eight ratios, none far below 1.
+    ClaimRow sl;
+    sl.id = "spring_only_slightly_faster";
+    sl.source = claim_source(pub, sl.id);
+    sl.settings = k.settings;
+    sl.quantity = "smallest t(spring) / t(cascade) over Figure 6.1.1's eight points";
+    double best = kInf, best_pub = kInf;
+    std::vector<std::string> fast;
+    for (int nodes : kNodes) {
+      const std::vector<double> s = at_thesis_counts(t.at("spring").at(nodes));
+      const std::vector<double> q = at_thesis_counts(t.at("cascade").at(nodes));
+      const std::vector<double> sp = published_times(fig, "halen_spring", nodes),
+                                cp = published_times(fig, "halen_cascade", nodes);
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        best = std::min(best, s[i] / q[i]);
+        best_pub = std::min(best_pub, sp[i] / cp[i]);
+        if (s[i] / q[i] < kSlightly)
+          fast.push_back(std::to_string(kThesisCounts[i]) + "×" + std::to_string(nodes) + ": " + num(s[i] / q[i]));
+      }
+    }
+    sl.published = best_pub;
+    sl.measured = best;
+    sl.min = kSlightly;
+    sl.threshold_why =
+        "slightly: at no point does the spring save a third or more of the cascade's time (every ratio at least "
+        "2/3). The thesis's own eight ratios run from " + num(best_pub) + " to " + num(worst_pub) +
+        " (savings of 2% to 29%); a saving of a half would make the spring twice as fast, which is not slightly";
+    sl.detail = k.detail;
+    sl.why_differs = "the spring takes less than 2/3 of the cascade's time at " + join(fast, "; ") +
+                     "; per strand, spring against cascade: " + join(parts, "; ");
     r.claims.push_back(std::move(k));
+    r.claims.push_back(std::move(sl));
   }
 
   // ---- Claim: the spring model is the most stable (§5.9) ----
