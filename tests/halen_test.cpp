@@ -940,6 +940,40 @@ TEST(HalenNodes, EveryModelStartsFromTheRestGroom) {
   }
 }
 
+// A model never simulates a strand at more nodes than the groom's strands have vertices
+// (nodes_for_groom): TressFX TestHair1's strands have 4, and at the default 8 nodes the
+// spring model laid 6 nodes on its 2 free edges, whose 1.2 cm segments an upright strand
+// left stretched by 79% in the first frame (`stretched`).
+TEST(HalenNodes, NodesNeverOutnumberTheGroomsVertices) {
+  ThreadPool pool(2);
+  // Every 37th guide (guide 8103 among them), simulated as the groom (follow hairs do not
+  // change what is tested).
+  Scenario sc = load_scenario(find_scenario("tressfx_testhair1"));
+  if (sc.follow) {
+    sc.groom = sc.guides;
+    sc.follow.reset();
+  }
+  sc.groom = every_nth_strand(sc.groom, 37);
+  const Groom& g = sc.groom;
+  std::size_t most = 0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) most = std::max<std::size_t>(most, g.strand_size(s));
+  ASSERT_EQ(most, 4u);
+  for (const std::string model : {"halen_spring", "halen_cascade", "halen_forest"}) {
+    const ModelInfo* info = find_model(model);
+    const ParamSet p = resolve_params(*info, sc, {});
+    ASSERT_EQ(p.get_int("nodes"), 8);
+    auto m = make_model(*info, sc, p, pool, "", true);
+    ASSERT_NE(m->simulated_groom(), nullptr);
+    for (std::size_t s = 0; s < m->simulated_groom()->strand_count(); ++s)
+      ASSERT_EQ(m->simulated_groom()->strand_size(s), 4u) << model << " strand " << s;
+    EXPECT_NE(info->step_bound(g, p, sc.gravity).why.find("(at 4 nodes)"), std::string::npos) << model;
+    RunOptions opt;
+    opt.models = {model};
+    const RunRecord r = run_scenario(sc, opt, pool).front();
+    EXPECT_EQ(r.verdict.status, verdict::Status::ok) << model << ": " << r.verdict.reason;
+  }
+}
+
 // §5.9: k_L = k / (L c)^a, k at the root, decreasing faster for larger a.
 TEST(HalenKernels, StiffnessFalloff) {
   EXPECT_FLOAT_EQ(kernels::falloff_stiffness(100.0f, 0.0f, 10.0f, 2), 100.0f);

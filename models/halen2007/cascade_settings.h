@@ -24,7 +24,7 @@ namespace hairbench::halen_cascade {
 
 inline constexpr std::array<ParamSpec, 10> kParams{{
     {"nodes", 8, 2, 64, true,
-     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5); stiffness is given at 8 nodes and scales as ((nodes - 1) / 7)^4"},
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; stiffness is given at 8 nodes and scales as ((nodes - 1) / 7)^3.6"},
     {"damping", 0.03, 0.0, 1.0, false,
      "fraction of velocity removed per sixth of a frame in Verlet (Eq. 4.1: k = 1 - damping), taken per "
      "substep as the same per frame at any substep count"},

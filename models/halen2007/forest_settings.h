@@ -47,7 +47,7 @@ namespace hairbench::halen_forest {
 
 inline constexpr std::array<ParamSpec, 14> kParams{{
     {"nodes", 8, 2, 64, true,
-     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5); joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2"},
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2"},
     {"joint_stiffness", 1100.0, 0.0, 1e6, false,
      "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2"},
     {"joint_damping", 26.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},

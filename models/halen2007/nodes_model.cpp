@@ -2,6 +2,7 @@
 
 #include "core/parallel.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hairbench::halen {
@@ -23,8 +24,18 @@ ParamSet at_nodes(const ParamSet& p, std::span<const NodeScaling> scaling) {
   return out;
 }
 
-StepBound bound_at_nodes(BoundFn bound, const NodeTraits& traits, const Groom& g, const ParamSet& p,
+ParamSet nodes_for_groom(const Groom& g, const ParamSet& p) {
+  std::size_t most = 0;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) most = std::max<std::size_t>(most, g.strand_size(s));
+  ParamSet out = p;
+  if (most > 0 && static_cast<std::size_t>(p.get_int("nodes")) > most)
+    out.set("nodes", static_cast<double>(most), {"", "the groom's vertices per strand."});
+  return out;
+}
+
+StepBound bound_at_nodes(BoundFn bound, const NodeTraits& traits, const Groom& g, const ParamSet& given,
                          const Vec3f& gravity) {
+  const ParamSet p = nodes_for_groom(g, given);
   const kernels::NodeLayout layout = kernels::layout_nodes(g, p.get_int("nodes"), traits.tied_static, traits.root_node_only);
   StepBound b = bound(layout.nodes, at_nodes(p, traits.scaling), gravity);
   b.why += " (at " + std::to_string(p.get_int("nodes")) + " nodes)";
@@ -34,8 +45,9 @@ StepBound bound_at_nodes(BoundFn bound, const NodeTraits& traits, const Groom& g
 NodesModel::NodesModel(std::unique_ptr<HairModel> inner, const NodeTraits& traits, const ModelContext& ctx)
     : inner_(std::move(inner)), traits_(traits), ctx_(ctx) {}
 
-void NodesModel::reset(const Groom& rest, const ParamSet& params) {
+void NodesModel::reset(const Groom& rest, const ParamSet& given) {
   rest_ = rest;
+  const ParamSet params = nodes_for_groom(rest, given);
   layout_ = kernels::layout_nodes(rest, params.get_int("nodes"), traits_.tied_static, traits_.root_node_only);
   inner_->reset(layout_.nodes, at_nodes(params, traits_.scaling));
   drawn_ = rest.positions;

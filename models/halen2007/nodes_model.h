@@ -75,6 +75,13 @@ inline constexpr double kDampingSubsteps = 6.0;
 // p's `nodes`, and the damping per substep.
 ParamSet at_nodes(const ParamSet& p, std::span<const NodeScaling> scaling);
 
+// `p` with `nodes` at most the most vertices any strand of `g` has: §5.5 draws a groom's
+// vertices from fewer simulated nodes, and more nodes than a strand's vertices would only
+// add short segments between them (8 nodes on TressFX TestHair1's 4-vertex strands: 1.2 cm
+// segments, which an upright strand's edge corrections left stretched by 79% in its first
+// frame).
+ParamSet nodes_for_groom(const Groom& g, const ParamSet& p);
+
 // A model's step bound (step_bounds.h) on the nodes it simulates the groom at, with the
 // scaled parameters.
 using BoundFn = StepBound (*)(const Groom&, const ParamSet&, const Vec3f&);
