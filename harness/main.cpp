@@ -437,6 +437,10 @@ int run_batches(CompareArgs& a, bool sweep) {
       std::vector<RunRecord> got = run_scenario(sc, opt, pool);
       runs_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       progress.end();
+      // A deviation measures accuracy only against a reference that is ok.
+      if (!got.empty() && got.front().reference_status != verdict::Status::ok)
+        std::printf("  reference %s is %s here: every dev below is measured against it\n",
+                    got.front().reference.c_str(), std::string(verdict::status_name(got.front().reference_status)).c_str());
       for (const RunRecord& r : got) {
         print_run(run_json(r));
         for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;

@@ -850,13 +850,20 @@ std::vector<RunRecord> LockstepRun::run() {
   for (Lane& l : lanes_) l.record.state_hash = metrics::state_hash(l.model->positions());
   extend_settle(frames);
 
-  std::vector<RunRecord> out;
   for (Lane& l : lanes_) {
     RunRecord& r = l.record;
     std::optional<std::pair<int, double>> stop;
     if (r.failure) stop = std::make_pair(r.failure->frame, r.failure->t);
     r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", stretch_of(l), l.settle.result(),
                                 l.probe, sc_.dt);
+  }
+  // Lane 0 is the reference: every deviation carries its verdict.
+  const verdict::Verdict reference = lanes_[0].record.verdict;
+  std::vector<RunRecord> out;
+  for (Lane& l : lanes_) {
+    RunRecord& r = l.record;
+    r.reference_status = reference.status;
+    if (reference.status != verdict::Status::ok) r.reference_reason = reference.reason;
     if (l.reported) out.push_back(std::move(r));
   }
   return out;

@@ -203,7 +203,14 @@ def reference_text(run):
     o = dev.get("reference_overrides")
     if o:
         ref += " (" + ", ".join(f"{k} {v:g}" for k, v in sorted(o.items())) + ")"
+    if not reference_ok(run):
+        ref += ", itself " + dev["reference_status"]
     return ref
+
+
+def reference_ok(run):
+    """Whether the run's reference is ok on its scenario (reports before the field: yes)."""
+    return run["metrics"]["deviation_vs_reference"].get("reference_status", "ok") == "ok"
 
 
 def grid(n, ncols_max=3, w=5.2, h=4.0):
@@ -319,7 +326,12 @@ def chart_time_vs_error(report, out_dir, stem, written, svg):
                 if e == 0:
                     ax.annotate("= reference", (x, y), textcoords="offset points", xytext=(4, -10), fontsize=7)
             series.append({"model": model, "points": len(pts)})
-        front = pareto_front([p for p in stable if p[2]["status"] == "ok"])
+        # Against a reference that is not ok a deviation is no measure of accuracy: no front.
+        sound = all(reference_ok(r) for r in runs)
+        front = pareto_front([p for p in stable if p[2]["status"] == "ok"]) if sound else []
+        if not sound:
+            ax.text(0.5, 0.5, "the reference is not ok here:\ndeviations are not accuracy, no Pareto front",
+                    transform=ax.transAxes, fontsize=8, color="tab:red", ha="center", va="center", alpha=0.8)
         for status, marker in STATUS_MARKERS.items():
             if any(r["status"] == status for _, _, r in stable):
                 ax.plot([], [], marker, color="grey", mfc="white", label=status + " (docs/verdicts.md)")
@@ -677,6 +689,10 @@ def scenario_notes(report, name):
     runs = [r for r in report["runs"] if r["scenario"] == name]
     notes.append(f"reference: {reference_text(runs[0])}; {runs[0]['groom']['strands']} strands, "
                  f"{runs[0]['groom']['vertices']} vertices, {runs[0]['frames']} frames")
+    if not reference_ok(runs[0]):
+        dev = runs[0]["metrics"]["deviation_vs_reference"]
+        notes.append(f"the reference is {dev['reference_status']} here ({dev.get('reference_reason', '')}): the "
+                     "deviations are measured against it, not against a sound solution, and no Pareto front is drawn")
     merge = report.get("merge") or {}
     if len(merge.get("machines", [])) > 1:
         which = machine_of(report)

@@ -283,10 +283,12 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
     if (r.t[f] >= r.settle_from - 1e-9) settled.push_back(r.rest_shape_error[f]);
 
   nlohmann::json deviation = {{"reference", r.reference},
+                               {"reference_status", std::string(verdict::status_name(r.reference_status))},
                                {"rms", num(rms(r.deviation))},
                                {"max", num(finite_max(r.deviation))},
                                {"final", num(r.deviation.empty() ? NAN : r.deviation.back())}};
   if (!r.reference_overrides.empty()) deviation["reference_overrides"] = r.reference_overrides;
+  if (!r.reference_reason.empty()) deviation["reference_reason"] = r.reference_reason;
   nlohmann::json metrics = {
       {"deviation_vs_reference", std::move(deviation)},
       {"jaggedness", {{"mean", num(finite_mean(r.jaggedness))}, {"max", num(finite_max(r.jaggedness))}}},

@@ -41,6 +41,10 @@ struct RunRecord {
   verdict::Verdict verdict;         // the run's stability class (reports/verdict.h)
 
   std::string reference;  // model the deviation is measured against
+  // The reference's own verdict on this scenario (its run at the reference's settings):
+  // a deviation is a measure of accuracy only against a reference that is `ok`.
+  verdict::Status reference_status = verdict::Status::ok;
+  std::string reference_reason;  // the reference's verdict reason when it is not ok
   // Per frame actually run (a failed run stops early).
   std::vector<double> step_ms;
   // Per frame run: 1 where the model worked (the head moved, wind blew, or some strand was

@@ -257,6 +257,32 @@ def check_asleep(charts_py, golden, tmp):
     check("<b>asleep</b>" in page, "asleep: the overview says so")
 
 
+def check_unsound_reference(charts_py, golden, tmp):
+    """A scenario whose reference is not ok: its deviations are no accuracy, so its panel
+    has no Pareto front and the overview says why; the other scenarios keep theirs."""
+    with open(golden) as f:
+        rep = json.load(f)
+    name = rep["runs"][0]["scenario"]
+    for r in rep["runs"]:
+        if r["scenario"] == name:
+            r["metrics"]["deviation_vs_reference"].update(
+                {"reference_status": "unstable", "reference_reason": "motion does not decay (test)"})
+    src, out = os.path.join(tmp, "unsound_src"), os.path.join(tmp, "unsound")
+    os.makedirs(src)
+    os.makedirs(out)
+    doctored = os.path.join(src, "unsound_reference.json")
+    with open(doctored, "w") as f:
+        json.dump(rep, f)
+    _, m, stem = run_on(charts_py, doctored, out)
+    panels = {p["scenario"]: p for p in m["charts"]["time_vs_error"]["panels"]}
+    check(panels[name]["pareto"] == [], f"unsound reference: {name} still has a Pareto front")
+    others = [n for n in panels if n != name]
+    check(bool(others) and all(panels[n]["pareto"] for n in others), "unsound reference: the other fronts kept")
+    summary = open(f"{stem}_summary.md", encoding="utf-8").read()
+    check("the reference is unstable here (motion does not decay (test))" in summary,
+          "unsound reference: the overview says so")
+
+
 def check_svg(charts_py, golden, tmp):
     """--svg: SVG next to every PNG, the strand lines an embedded raster, not paths."""
     out = os.path.join(tmp, "svg")
@@ -307,6 +333,8 @@ def main():
         guarded("sweep", check_sweep, charts_py, data, tmp)
         guarded("asleep", check_asleep, charts_py, os.path.join(data, "compare_asleep.json"), tmp)
         guarded("--svg", check_svg, charts_py, os.path.join(data, "compare_report.json"), tmp)
+        guarded("unsound reference", check_unsound_reference, charts_py, os.path.join(data, "compare_report.json"),
+                tmp)
         guarded("bad report", check_bad, charts_py, tmp)
         guarded("stress", check_stress, os.path.join(os.path.dirname(charts_py), "stress_chart.py"),
                 os.path.join(data, "stress_small.json"), tmp)

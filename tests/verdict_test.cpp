@@ -7,6 +7,7 @@
 #include "harness/probe.h"
 #include "harness/runner.h"
 #include "models/registry.h"
+#include "reports/report.h"
 #include "reports/verdict.h"
 #include "test_support.h"
 
@@ -219,6 +220,37 @@ TEST(Verdict, CascadeOnIdleRestsAndItsFixedReferenceNodesAreUnstable) {
     EXPECT_EQ(m1.verdict.status, Status::ok) << m1.verdict.reason;
   }
   EXPECT_EQ(test::find(runs[1][0], "halen_cascade").state_hash, test::find(runs[1][1], "halen_cascade").state_hash);
+}
+
+// A deviation measures accuracy only against a reference that is ok: every run carries
+// the reference's own verdict on its scenario, in the record and in report.json. Against
+// the cascade with fixed reference nodes (unstable on idle, above) han_m3's run says so
+// and why; against han_m1, which rests, it says ok and gives no reason.
+TEST(Verdict, EveryRunCarriesItsReferencesVerdict) {
+  const Scenario sc = idle_with(16);
+  ThreadPool pool(2);
+  RunOptions opt;
+  opt.models = {"han_m3"};
+  opt.reference = "halen_cascade";
+  opt.reference_overrides = {{"halen_cascade", "reactions", 0}};
+  const RunRecord against_unstable = run_scenario(sc, opt, pool).front();
+  EXPECT_EQ(against_unstable.reference, "halen_cascade");
+  EXPECT_EQ(against_unstable.reference_status, Status::unstable);
+  EXPECT_NE(against_unstable.reference_reason.find("perturbation"), std::string::npos)
+      << against_unstable.reference_reason;
+  const nlohmann::json dev = run_json(against_unstable)["metrics"]["deviation_vs_reference"];
+  EXPECT_EQ(dev["reference_status"], "unstable");
+  EXPECT_EQ(dev["reference_reason"], against_unstable.reference_reason);
+
+  RunOptions plain;
+  plain.models = {"han_m3"};
+  const RunRecord against_ok = run_scenario(sc, plain, pool).front();
+  EXPECT_EQ(against_ok.reference, "han_m1");
+  EXPECT_EQ(against_ok.reference_status, Status::ok);
+  EXPECT_TRUE(against_ok.reference_reason.empty());
+  const nlohmann::json ok_dev = run_json(against_ok)["metrics"]["deviation_vs_reference"];
+  EXPECT_EQ(ok_dev["reference_status"], "ok");
+  EXPECT_FALSE(ok_dev.contains("reference_reason"));
 }
 
 TEST(EnergySpread, CountsTheStrandsThatHoldNinetyPercent) {
