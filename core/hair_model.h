@@ -139,6 +139,10 @@ class HairModel {
   // positions()). nullptr and empty: the model simulates every groom vertex.
   virtual const Groom* simulated_groom() const { return nullptr; }
   virtual std::span<const Vec4f> simulated_positions() const { return {}; }
+  // The parameters the model runs at, after reset(), where the groom changed one it was
+  // given (Halén & Wester's nodes, at most a strand's vertices); the report shows these.
+  // nullptr: the ones given.
+  virtual const ParamSet* run_params() const { return nullptr; }
 };
 
 }  // namespace hairbench

@@ -32,6 +32,7 @@ class FollowHairsAdapter final : public HairModel {
   std::size_t static_strands() const override { return inner_->static_strands(); }
   const Groom* simulated_groom() const override { return inner_->simulated_groom(); }
   std::span<const Vec4f> simulated_positions() const override { return inner_->simulated_positions(); }
+  const ParamSet* run_params() const override { return inner_->run_params(); }
 
  private:
   void rebuild();

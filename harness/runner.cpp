@@ -441,7 +441,7 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   if (const Groom* nodes = lane.model->simulated_groom()) lane.nodes.emplace(*nodes);
   r.dt = sc_.dt;
   r.settle_from = sc_.settle_from;
-  r.params = params_json(params, sc_.groom);
+  r.params = params_json(lane.model->run_params() ? *lane.model->run_params() : params, sc_.groom);
   if (const auto c = choose_substeps(*info, sc_, params, overrides)) r.substeps = substeps_json(*c);
   r.reference = reference_;
   r.reference_overrides = ref_overrides_;

@@ -971,6 +971,7 @@ TEST(HalenNodes, NodesNeverOutnumberTheGroomsVertices) {
     opt.models = {model};
     const RunRecord r = run_scenario(sc, opt, pool).front();
     EXPECT_EQ(r.verdict.status, verdict::Status::ok) << model << ": " << r.verdict.reason;
+    EXPECT_EQ(r.params["nodes"], 4.0) << model << ": the report shows the count the model ran at";
   }
 }
 

@@ -47,9 +47,9 @@ NodesModel::NodesModel(std::unique_ptr<HairModel> inner, const NodeTraits& trait
 
 void NodesModel::reset(const Groom& rest, const ParamSet& given) {
   rest_ = rest;
-  const ParamSet params = nodes_for_groom(rest, given);
-  layout_ = kernels::layout_nodes(rest, params.get_int("nodes"), traits_.tied_static, traits_.root_node_only);
-  inner_->reset(layout_.nodes, at_nodes(params, traits_.scaling));
+  params_ = nodes_for_groom(rest, given);
+  layout_ = kernels::layout_nodes(rest, params_.get_int("nodes"), traits_.tied_static, traits_.root_node_only);
+  inner_->reset(layout_.nodes, at_nodes(params_, traits_.scaling));
   drawn_ = rest.positions;
   frame_.resize(layout_.nodes.vertex_count());
   draw(Affine3f::Identity());

@@ -101,10 +101,12 @@ class NodesModel final : public HairModel {
   std::size_t static_strands() const override { return layout_.static_strands; }
   const Groom* simulated_groom() const override { return &layout_.nodes; }
   std::span<const Vec4f> simulated_positions() const override { return inner_->positions(); }
+  const ParamSet* run_params() const override { return &params_; }
 
  private:
   void draw(const Affine3f& head);
 
+  ParamSet params_;  // as given, `nodes` at most the groom's (nodes_for_groom)
   std::unique_ptr<HairModel> inner_;
   NodeTraits traits_;
   ModelContext ctx_;
