@@ -278,26 +278,37 @@ struct Static {
 constexpr double kRestRange = 1e-4;
 constexpr double kMaxStaticSeconds = 600.0;
 
+// One strand of a model at its own substeps (as the thesis ran them), reset at rest, and
+// the input of a frame with gravity off, the head still and no colliders.
+struct OneStrand {
+  OneStrand(const std::string& model, const std::vector<ParamOverride>& set, const Groom& strand) {
+    Scenario sc;
+    sc.name = "halen2007 one strand";
+    sc.auto_substeps = false;
+    sc.groom = strand;
+    sc.region_params.assign(1, {});
+    const ModelInfo& info = model_info(model);
+    m = info.make(ModelContext{&pool});
+    m->reset(sc.groom, resolve_params(info, sc, set));
+    in.dt = sc.dt;
+    in.gravity = Vec3f::Zero();
+  }
+  ThreadPool pool{1};
+  std::unique_ptr<HairModel> m;
+  FrameInput in;
+};
+
 // One strand under a constant acceleration `accel` along `dir` (wind that meets the
 // strand face-on, core/types.h), gravity off, the head still, no colliders, until the tip
 // rests or `max_frames` have run.
 Static static_deflection(const std::string& model, const std::vector<ParamOverride>& set, const Groom& strand,
                          const Vec3f& dir, float accel, int max_frames) {
-  Scenario sc;
-  sc.name = "halen2007 static";
-  sc.auto_substeps = false;  // each model at its own substeps, as the thesis ran them
-  sc.groom = strand;
-  sc.region_params.assign(1, {});
-  const ModelInfo& info = model_info(model);
-  ThreadPool pool(1);
-  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool});
-  m->reset(sc.groom, resolve_params(info, sc, set));
-  FrameInput in;
-  in.dt = sc.dt;
-  in.gravity = Vec3f::Zero();
+  OneStrand one(model, set, strand);
+  HairModel* m = one.m.get();
+  FrameInput& in = one.in;
   in.wind = Wind{dir, accel};
   StageTimes times;
-  const Vec3f tip = sc.groom.positions.back().head<3>();
+  const Vec3f tip = strand.positions.back().head<3>();
   const int window = std::min(60, max_frames);
   Static r;
   for (int frame = 0; frame + window <= max_frames;) {
@@ -412,20 +423,11 @@ Match match_stiffness(const Config& c, const Groom& strand, const Vec3f& dir, fl
 // joints' relative rates (Eq. 4.2.2) and damps its slowest mode least: this is where
 // they are compared. NaN if the tip does not move or the run blows up.
 double decay_rate(const std::string& model, const std::vector<ParamOverride>& set, const Groom& strand) {
-  Scenario sc;
-  sc.name = "halen2007 decay";
-  sc.auto_substeps = false;
-  sc.groom = strand;
-  sc.region_params.assign(1, {});
-  const ModelInfo& info = model_info(model);
-  ThreadPool pool(1);
-  std::unique_ptr<HairModel> m = info.make(ModelContext{&pool});
-  m->reset(sc.groom, resolve_params(info, sc, set));
-  FrameInput in;
-  in.dt = sc.dt;
-  in.gravity = Vec3f::Zero();
+  OneStrand one(model, set, strand);
+  HairModel* m = one.m.get();
+  FrameInput& in = one.in;
   StageTimes times;
-  Vec3f tip = sc.groom.positions.back().head<3>();
+  Vec3f tip = strand.positions.back().head<3>();
   constexpr int kPush = 60, kWindow = 15, kWindows = 24;
   std::vector<double> rms;
   double sum = 0.0;
