@@ -285,36 +285,44 @@ std::vector<Repair> repair_groom(Groom& g, DegeneratePolicy policy, const std::s
   std::vector<Repair> out;
   const auto fail = [&](const std::string& field, const std::string& what) { throw InputError(source, field, what); };
 
-  // Near-zero edges: relative to the strand's own median edge, and never under 1e-7 m,
-  // validate_groom's floor.
+  // Near-zero and short edges: relative to the strand's own median edge, and never under
+  // 1e-7 m, validate_groom's floor. A strand with either is resampled once; the repair
+  // that names it is the worse of its edges'.
   Repair edges{"near_zero_edges", 0, 0, "strand resampled at equal arc-length steps", ""};
+  Repair shortened{"short_edges", 0, 0, "strand resampled at equal arc-length steps", ""};
   std::vector<double> e, sorted;
   for (std::size_t s = 0; s < g.strand_count(); ++s) {
     if (g.strand_size(s) < 2) continue;  // validate_groom names it
     edge_lengths(g, s, e);
     sorted = e;
-    const double limit = std::max(kNearZeroEdge * median(sorted), 1e-7);
-    std::size_t bad = 0;
+    const double med = median(sorted);
+    const double zero = std::max(kNearZeroEdge * med, 1e-7), short_limit = kShortEdge * med;
+    std::size_t near_zero = 0, short_ones = 0;
     double total = 0.0;
     for (std::size_t i = 0; i < e.size(); ++i) {
       total += e[i];
-      if (e[i] >= limit) continue;
+      if (e[i] >= short_limit) continue;
+      const bool is_zero = e[i] < zero;
       if (policy == DegeneratePolicy::Refuse)
         fail("strand " + std::to_string(s) + " edge " + std::to_string(i),
-             "near-zero rest edge of " + text(e[i]) + " m (under " + text(kNearZeroEdge) +
+             std::string(is_zero ? "near-zero" : "short") + " rest edge of " + text(e[i]) + " m (under " +
+                 text(is_zero ? kNearZeroEdge : kShortEdge) +
                  " of the strand's median edge; \"degenerate\": \"repair\" resamples the strand)");
-      if (edges.example.empty()) edges.example = edge_example(s, i, e[i]);
-      ++bad;
+      Repair& r = is_zero ? edges : shortened;
+      if (r.example.empty()) r.example = edge_example(s, i, e[i]);
+      ++(is_zero ? near_zero : short_ones);
     }
-    if (bad == 0) continue;
+    if (near_zero + short_ones == 0) continue;
     // Resampling spreads the length over the edges; a strand with (almost) none cannot be.
     if (!(total > 1e-7 * static_cast<double>(e.size())))
       fail("strand " + std::to_string(s), "has zero length (every vertex at one point)");
     resample(g, s, e);
-    edges.items += bad;
-    ++edges.strands;
+    edges.items += near_zero;
+    shortened.items += short_ones;
+    ++(near_zero > 0 ? edges : shortened).strands;
   }
   if (edges.strands > 0) out.push_back(edges);
+  if (shortened.strands > 0) out.push_back(shortened);
 
   // Duplicate strands: the same vertices as an earlier strand (exporters that write a
   // strand twice). Grouped by the root's bits, then compared whole.
@@ -396,6 +404,8 @@ std::string repairs_text(const std::vector<Repair>& repairs) {
     out += i == 0 ? " " : "; ";
     if (r.kind == "near_zero_edges")
       out += std::to_string(r.items) + " near-zero edges in " + std::to_string(r.strands) + " strands resampled";
+    else if (r.kind == "short_edges")
+      out += std::to_string(r.items) + " short edges in " + std::to_string(r.strands) + " strands resampled";
     else if (r.kind == "coincident_roots")
       out += std::to_string(r.strands) + " duplicate strands removed";
     else

@@ -92,6 +92,15 @@ float metres_per_unit(const std::string& unit);
 // direction is rounding noise or an exporter's duplicate vertex, and an explicit
 // integrator's step would have to shrink with it.
 inline constexpr double kNearZeroEdge = 1e-2;
+// A rest edge shorter than this fraction of its strand's median edge, though not near
+// zero, turns the frames a position-based solver reads the next edge's shape in by
+// e / l for an error e at its end (Han & Harada 2012 §3.4 reads method 1's local goals in
+// the current parent edge's frame), so short edges amplify the iteration's error by the
+// ratio of the edges beyond it to it. Measured with method 1 at its defaults: a straight
+// 16-vertex strand with one edge shortened to r of the others rests at r = 0.15 and
+// flutters at r = 0.1; a folded TressFX ponytail guide flutters with its 2 mm edge at
+// r = 0.21 (docs/limitations.md). A quarter leaves a margin above both.
+inline constexpr double kShortEdge = 0.25;
 // A strand shorter than this fraction of the groom's median strand length is far
 // shorter than the rest: its edges are too short for a solver tuned to the groom.
 inline constexpr double kShortStrand = 0.1;
@@ -99,7 +108,7 @@ inline constexpr double kShortStrand = 0.1;
 enum class DegeneratePolicy { Repair, Refuse };
 
 struct Repair {
-  std::string kind;  // "near_zero_edges", "coincident_roots", "short_strands"
+  std::string kind;  // "near_zero_edges", "short_edges", "coincident_roots", "short_strands"
   std::size_t strands = 0;  // strands affected
   std::size_t items = 0;    // edges, strands
   std::string action;       // what was done
@@ -111,6 +120,7 @@ struct Repair {
 //  - near-zero edges (kNearZeroEdge, exact zeros included): the strand is resampled to
 //    the same vertex count at equal arc-length steps along its polyline (every new vertex
 //    lies on the old polyline; vertices keep their inverse masses by index);
+//  - short edges (kShortEdge, not near zero): resampled the same way;
 //  - coincident roots, a strand whose every vertex repeats an earlier strand's: removed;
 //  - short strands (kShortStrand): every vertex pinned, so they move rigidly with the head.
 // The importers run it before they make follow hairs, which copy their guides. Returns

@@ -9,7 +9,8 @@
 //  - a near-degenerate edge is rounding-sized: it changes no model's verdict;
 //  - the cascade's reference springs, halves of torsion springs, make its rest state
 //    stable at every strand length (4, 32 and 64 nodes).
-// And for every built-in scenario, skipping (inert stages, sleep) changes no verdict.
+// And for every built-in scenario, skipping (inert stages, sleep) changes no verdict, and
+// the reference every deviation is measured against is itself ok.
 #include "core/parallel.h"
 #include "harness/probe.h"
 #include "harness/runner.h"
@@ -199,6 +200,22 @@ TEST(Sleep, SkippingNeverChangesAVerdictOrAMetric) {
       near(skipped.jaggedness, full.jaggedness, 10 * kSleepTolerance, "jaggedness");
       near(skipped.length_max, full.length_max, 100 * kSleepTolerance, "length error");
     }
+  }
+}
+
+// Every deviation in a report is measured against the scenario's reference (method 1):
+// on a built-in scenario it must be sound, whole groom, every frame, at its own settings.
+TEST(Reference, IsOkOnEveryBuiltInScenario) {
+  ThreadPool pool(2);
+  for (const auto& file : builtin_scenarios()) {
+    const Scenario sc = load_scenario(file);
+    SCOPED_TRACE(sc.name);
+    RunOptions opt;
+    opt.models = {sc.reference};
+    const std::vector<RunRecord> runs = run_scenario(sc, opt, pool);
+    ASSERT_EQ(runs.size(), 1u);
+    EXPECT_EQ(verdict::status_name(runs[0].verdict.status), "ok") << runs[0].verdict.reason;
+    EXPECT_EQ(runs[0].reference_status, verdict::Status::ok);
   }
 }
 

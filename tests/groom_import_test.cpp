@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -146,6 +147,44 @@ TEST(Hygiene, NearZeroEdgesAreResampledAndListed) {
   }
   EXPECT_EQ(repairs_text(repairs).rfind("repairs: 2 near-zero edges in 2 strands resampled (first: strand 100 edge 5", 0),
             0u);
+}
+
+// Short edges, authored but under kShortEdge of the strand's median (the ponytail's folded
+// guide), are resampled and listed apart from near-zero ones; an edge above the limit is
+// left as authored.
+TEST(Hygiene, ShortEdgesAreResampledAndEdgesAboveTheLimitKept) {
+  Groom g = tfx::load_tfx_asset(kMohawk, {0.01f}).groom;
+  auto shorten = [&](std::size_t s, std::uint32_t edge, double fraction) {
+    std::vector<float> e;
+    for (std::uint32_t v = g.strand_begin(s); v + 1 < g.strand_begin(s + 1); ++v)
+      e.push_back((g.positions[v + 1] - g.positions[v]).head<3>().norm());
+    std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
+    Vec4f& b = g.positions[g.strand_begin(s) + edge + 1];
+    const Vec4f& a = g.positions[g.strand_begin(s) + edge];
+    b.head<3>() = a.head<3>() + static_cast<float>(fraction) * e[e.size() / 2] * (b - a).head<3>().normalized();
+  };
+  const Groom clean = g;
+  shorten(300, 10, 0.9 * kShortEdge);
+  shorten(400, 10, 1.2 * kShortEdge);
+  const Groom authored = g;
+  const std::vector<Repair> repairs = repair_groom(g, DegeneratePolicy::Repair, "mohawk");
+  ASSERT_EQ(repairs.size(), 1u);
+  EXPECT_EQ(repairs[0].kind, "short_edges");
+  EXPECT_EQ(repairs[0].strands, 1u);
+  EXPECT_EQ(repairs[0].items, 1u);
+  EXPECT_EQ(repairs[0].example.rfind("strand 300 edge 10 (", 0), 0u) << repairs[0].example;
+  EXPECT_EQ(repairs_text(repairs).rfind("repairs: 1 short edges in 1 strands resampled (first: strand 300 edge 10", 0), 0u)
+      << repairs_text(repairs);
+  const std::vector<float> len = rest_edge_lengths(g);
+  const std::uint32_t b = g.strand_begin(300);
+  EXPECT_GT(len[b + 10], 0.5f * len[b + 2]);
+  for (std::uint32_t v = g.strand_begin(400); v < g.strand_begin(401); ++v)
+    EXPECT_EQ(g.positions[v], authored.positions[v]) << "vertex " << v;
+  EXPECT_EQ(error_of([&] { Groom r = authored; repair_groom(r, DegeneratePolicy::Refuse, "m.tfx"); })
+                .rfind("m.tfx: strand 300 edge 10: short rest edge of ", 0),
+            0u);
+  Groom untouched = clean;
+  for (const Repair& r : repair_groom(untouched, DegeneratePolicy::Repair, "mohawk")) EXPECT_NE(r.kind, "short_edges");
 }
 
 TEST(Hygiene, RefuseNamesTheStrandAndEdge) {
