@@ -12,6 +12,10 @@
 
 namespace hairbench {
 
+// What a parameter sets of the material a model describes, for `--calibrate`
+// (harness/calibrate.h): the one stiffness and the one damping it fits per model.
+enum class ParamRole { none, stiffness, damping };
+
 struct ParamSpec {
   std::string_view name;
   double default_value;
@@ -19,6 +23,7 @@ struct ParamSpec {
   double max;
   bool integer;
   std::string_view help;
+  ParamRole role = ParamRole::none;
 };
 
 class ParamSet {

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <optional>
 #include <span>
 
 namespace hairbench {
@@ -43,6 +44,14 @@ struct FrameInput {
   Vec3f gravity = Vec3f::Zero();
   Wind wind;
   std::span<const Sphere> colliders;
+  // Gravity as the head sees it in its rest orientation, for a model whose forces are
+  // fixed to the head (Halén & Wester §4.4: a displacement "kept static in relation to
+  // the base", a stiffness that weakens as the head tilts from up). Unset, as in every
+  // scripted run, it is `gravity`: the step works in the world, whose frame is the head's
+  // at rest. A step that works in another frame (the rest twin, harness/twin.h, steps in
+  // the head's frame at its final pose) sets it, so that such a model sees the same head.
+  std::optional<Vec3f> rest_gravity;
+  Vec3f gravity_at_rest() const { return rest_gravity ? *rest_gravity : gravity; }
 };
 
 // Head transform at a fraction s in [0, 1] of the step: slerp of the rotation and lerp

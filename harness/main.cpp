@@ -71,7 +71,7 @@ constexpr const char* kStressHelp =
     "velocity and acceleration, teleports, strand vertices and\n"
     "length, every stiffness, iteration count and damping) from\n"
     "the stable base scenario until each CPU model's verdict is\n"
-    "no longer ok (stretched, unstable or diverged), runs\n"
+    "no longer ok (stretched, deformed, unstable or diverged), runs\n"
     "degenerate grooms, prints the table, writes DIR/stress.json\n"
     "and draws its heatmap DIR/stress_heatmap.png.";
 
@@ -267,6 +267,17 @@ void print_run(const nlohmann::json& r) {
     else
       std::printf("  %-14s substeps %d (auto; %s)\n", "", c["value"].get<int>(), c["bound"].get<std::string>().c_str());
   }
+  // What --calibrate fitted, and how close it came.
+  if (r.contains("calibration"))
+    for (const auto& fit : r["calibration"]["fits"]) {
+      std::string line = fit["role"].get<std::string>() + ": ";
+      if (fit.contains("on"))
+        line += fit["param"].get<std::string>() + " " + f(fit["from"], "%.3g") + " -> " + f(fit["to"], "%.3g") +
+                " on " + fit["on"].get<std::string>() + " " + f(fit["reached"], "%.3g") + " (reference " +
+                f(fit["target"], "%.3g") + (fit["within"].get<bool>() ? ", within" : ", not within") + ")";
+      if (fit.contains("note")) line += (fit.contains("on") ? "; " : "") + fit["note"].get<std::string>();
+      std::printf("  %-14s calibrated %s\n", "", line.c_str());
+    }
   // Every class but ok says why, and where it was decided.
   const auto& v = r["verdict"];
   if (v["class"] != "ok") {
@@ -402,7 +413,7 @@ int run_batches(CompareArgs& a, bool sweep) {
   int total = 0;
   for (const PlanItem& it : plan.items) total += it.shard == mine;
 
-  double models_s = 0.0, runs_s = 0.0, probes_s = 0.0, setup_s = 0.0, extra_s = 0.0;
+  double models_s = 0.0, runs_s = 0.0, probes_s = 0.0, twins_s = 0.0, setup_s = 0.0, extra_s = 0.0;
   ThreadPool pool(a.threads);
   Progress progress(total, true);
   std::vector<RunRecord> runs;
@@ -445,6 +456,7 @@ int run_batches(CompareArgs& a, bool sweep) {
         print_run(run_json(r));
         for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
         probes_s += r.probe_s;
+        twins_s += r.twin_s;
         setup_s += r.setup_s;
         extra_s += r.settle_extra_s;
       }
@@ -455,10 +467,10 @@ int run_batches(CompareArgs& a, bool sweep) {
   // Stepping the models is what a comparison measures; the rest is overhead.
   if (!a.groom.empty())
     std::printf("time: load %.3f s (read, repairs, follow hairs), fit %.3f s (unit, head sphere, collider), "
-                "model steps %.3f s, the models' probes %.3f s, setup %.3f s and steps past the end %.3f s, "
-                "metrics and the rest %.3f s\n",
-                groom_times.load_s, groom_times.fit_s, models_s, probes_s, setup_s, extra_s,
-                runs_s - models_s - probes_s - setup_s - extra_s);
+                "model steps %.3f s, the models' probes %.3f s, rest twins %.3f s, setup %.3f s and steps past the "
+                "end %.3f s, metrics and the rest %.3f s\n",
+                groom_times.load_s, groom_times.fit_s, models_s, probes_s, twins_s, setup_s, extra_s,
+                runs_s - models_s - probes_s - twins_s - setup_s - extra_s);
   nlohmann::json sweep_json;
   if (a.knob) sweep_json = {{"knob", knob_name}, {"values", values}, {"models", a.run.models}};
   return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan);
@@ -769,6 +781,10 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
                         "run every stage even where the scene makes it inert (no\n"
                         "colliders, no wind, zero stiffness) and never let strands\n"
                         "sleep");
+  sub.add_flag_callback("--calibrate", [&a] { a.run.calibrate = true; },
+                        "fit each model's stiffness and damping so that its material\n"
+                        "card matches the reference's, then run with them\n"
+                        "(a parameter set on the command line is kept)");
 }
 
 void add_stress_options(CLI::App& sub, StressArgs& a) {

@@ -4,7 +4,9 @@
 #include "core/parallel.h"
 #include "harness/follow_adapter.h"
 #include "harness/gpu_clock.h"
+#include "harness/calibrate.h"
 #include "harness/probe.h"
+#include "harness/twin.h"
 #include "harness/roofline.h"
 #include "harness/shard.h"
 #include "reports/device_metrics.h"
@@ -128,9 +130,14 @@ ParamSet resolve_params(const ModelInfo& model, const Scenario& sc, const std::v
     if (o.model == "*" && set.has(o.name)) set.set_everywhere(o.name, o.value, {"--set", "*."});
   for (const ParamOverride& o : overrides)
     if (o.model == model.name) set.set_everywhere(o.name, o.value, {"--set", o.model + "."});
-  if (const auto c = choose_substeps(model, sc, set, overrides); c && c->source == "auto")
-    set.set_everywhere("substeps", c->value, {sc.source.string(), "substeps (auto)."});
+  apply_auto_substeps(model, sc, set, overrides);
   return set;
+}
+
+void apply_auto_substeps(const ModelInfo& model, const Scenario& sc, ParamSet& params,
+                         const std::vector<ParamOverride>& overrides) {
+  if (const auto c = choose_substeps(model, sc, params, overrides); c && c->source == "auto")
+    params.set_everywhere("substeps", c->value, {sc.source.string(), "substeps (auto)."});
 }
 
 std::optional<SubstepsChoice> choose_substeps(const ModelInfo& model, const Scenario& sc, const ParamSet& resolved,
@@ -227,6 +234,11 @@ struct Lane {
   verdict::StretchTracker stretch;
   verdict::SettleCheck settle;
   verdict::Probe probe;
+  // The rest twin's state in the head's frame (empty: no twin), and the distance from it
+  // over the settle window.
+  std::vector<Vec4f> twin;
+  int twin_frames = 0;
+  verdict::ReturnTracker back{};
   double kinetic = 0.0;  // this frame's kinetic energy relative to the head
   // Metrics on the device (docs/metrics.md, Where the metrics are computed): the model's
   // kernel, whether it reads the reference's positions on its device, this frame's
@@ -247,7 +259,7 @@ struct Lane {
 class LockstepRun {
  public:
   LockstepRun(const Scenario& sc, const RunOptions& opt, ThreadPool& pool)
-      : sc_(sc), opt_(opt), pool_(pool), rest_(sc.groom, sc.follow ? sc.guides.strand_count() : sc.groom.strand_count()),
+      : sc_(sc), opt_(opt), pool_(pool), frames_(opt.frames > 0 ? opt.frames : sc.frames), rest_(sc.groom, sc.follow ? sc.guides.strand_count() : sc.groom.strand_count()),
         snap_strands_(snapshot_strands(sc.groom)) {
     // Follow hairs are their guide plus a rigid offset, with unconstrained edges: their
     // stretch belongs to the follow layer, so the stretched verdict reads the guides'.
@@ -264,6 +276,7 @@ class LockstepRun {
   void step_lanes(const FrameInput& in, bool driven);
   void stop_diverged(const FrameInput& in, int f, bool driven);
   void measure(const FrameInput& in);
+  void track_return(const FrameInput& in);
   void snapshot(const FrameInput& in, int f, int frames);
   void record_scenario(int frames) const;
   void time_gpu_lanes();
@@ -274,6 +287,7 @@ class LockstepRun {
   const Scenario& sc_;
   const RunOptions& opt_;
   ThreadPool& pool_;
+  const int frames_;
   const metrics::RestInfo rest_;
   std::optional<metrics::RestInfo> guides_;  // the simulated strands, where follow hairs are rebuilt
   const std::vector<std::uint32_t> snap_strands_;
@@ -417,15 +431,22 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   // would freeze the growth it is about to show (and change its metrics).
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  verdict::Probe probe;
-  if (opt_.probe) probe = perturbation_probe(*info, sc_, params, pool_, opt_.device);
+  AtRest at_rest;
+  if (opt_.probe) at_rest = probe_at_rest(*info, sc_, params, pool_, opt_.device);
+  else at_rest.card.skipped_why = "not measured (the probe at rest is off)";
+  const verdict::Probe& probe = at_rest.probe;
   const auto probed = Clock::now();
   const bool skip = opt_.skip_inert && !(probe.run && probe.grows);
+  RestTwin twin;
+  if (opt_.twin) twin = rest_twin(*info, sc_, params, pool_, opt_.device, skip, frames_);
+  const auto twinned = Clock::now();
   Lane lane{info, params, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
-            metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe};
+            metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe, std::move(twin.positions), twin.frames};
   RunRecord& r = lane.record;
+  r.card = at_rest.card;
   r.probe_s = std::chrono::duration<double>(probed - start).count();
-  r.setup_s = std::chrono::duration<double>(Clock::now() - probed).count();
+  r.twin_s = std::chrono::duration<double>(twinned - probed).count();
+  r.setup_s = std::chrono::duration<double>(Clock::now() - twinned).count();
   r.scenario = sc_.name;
   r.model = std::string(info->name);
   const Backend backend = lane.model->backend();
@@ -476,7 +497,22 @@ void LockstepRun::make_lanes() {
       lanes_[0].record.knob = opt_.knob;
       continue;
     }
-    add_lane(info, params, true, concat(opt_.overrides, opt_.model_overrides));
+    const std::vector<ParamOverride> given = concat(opt_.overrides, opt_.model_overrides);
+    if (!opt_.calibrate) {
+      add_lane(info, params, true, given);
+      continue;
+    }
+    // Fitted to the reference's card (lane 0's), keeping what the command line gave.
+    material::Calibration cal;
+    const material::Card& target = lanes_[0].record.card;
+    ParamSet fitted = params;
+    if (target.measured)
+      fitted = calibrate(*info, sc_, params, target, given, pool_, opt_.device, cal);
+    else
+      cal.fits.push_back({"", "", "", 1.0, material::kNaN, material::kNaN, material::kNaN, material::kNaN, false, 0,
+                          "the reference has no material card (" + target.skipped_why + ")"});
+    add_lane(info, fitted, true, given);
+    lanes_.back().record.calibration = std::move(cal);
   }
   use_device_metrics();
 }
@@ -657,6 +693,39 @@ void LockstepRun::measure(const FrameInput& in) {
   }
 }
 
+// verdict::Return: each lane's RMS distance from its rest twin, in the head's frame, every
+// frame of the settle window (the frames SettleCheck reads), and the farthest strand. One
+// task per lane, each value computed whole by one thread.
+void LockstepRun::track_return(const FrameInput& in) {
+  std::vector<std::span<const Vec4f>> p(lanes_.size());
+  for (std::size_t i = 0; i < lanes_.size(); ++i)
+    if (lanes_[i].running && !lanes_[i].twin.empty()) p[i] = lanes_[i].model->positions();
+  const Affine3f to_head = in.head.inverse();
+  const Groom& g = sc_.groom;
+  pool_.parallel_for(lanes_.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      Lane& l = lanes_[i];
+      if (p[i].empty()) continue;
+      double sum = 0.0, worst = -1.0;
+      std::uint32_t worst_strand = 0;
+      for (std::size_t s = 0; s < g.strand_count(); ++s) {
+        double strand = 0.0;
+        for (std::uint32_t v = g.strand_begin(s); v < g.strand_offsets[s + 1]; ++v)
+          strand += static_cast<double>((to_head * Vec3f(p[i][v].head<3>()) - l.twin[v].head<3>()).squaredNorm());
+        sum += strand;
+        const double rms = std::sqrt(strand / g.strand_size(s));
+        if (!(rms <= worst)) {
+          worst = rms;
+          worst_strand = static_cast<std::uint32_t>(s);
+        }
+      }
+      const double length = rest_.mean_strand_length;
+      l.back.add(in.t, std::sqrt(sum / static_cast<double>(g.vertex_count())) / length);
+      l.back.set_worst(worst_strand, worst / length);
+    }
+  });
+}
+
 // Snapshots: the most violent frame is the first one where the reference's kinetic
 // energy relative to the head is highest; a new one replaces the previous one in every
 // lane (a lane that has stopped has none there). The final frame is the last one each
@@ -731,6 +800,7 @@ void LockstepRun::record_scenario(int frames) const {
   h.text(scenario_hash(sc_, frames)).text(reference_);
   for (const auto& [name, v] : ref_overrides_) h.text(name).value(v);
   for (const ParamOverride& o : opt_.overrides) h.text(o.model).text(o.name).value(o.value);
+  if (opt_.calibrate) h.text("calibrate");
   char b[17];
   std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h.digest()));
   out.definition_hash = b;
@@ -825,7 +895,7 @@ std::vector<RunRecord> LockstepRun::run() {
   // Once every lane is made (the CPU models' probes take a while): the GPU models' clock
   // is up as the first frame starts.
   for (Lane& l : lanes_) l.model->warm_up(frame_input(sc_, 0), kGpuWarmUpSeconds);
-  const int frames = opt_.frames > 0 ? opt_.frames : sc_.frames;
+  const int frames = frames_;
   for (Lane& l : lanes_) l.record.frames = frames;
   for (int f = 0; f < frames; ++f) {
     const FrameInput in = frame_input(sc_, f);
@@ -838,6 +908,7 @@ std::vector<RunRecord> LockstepRun::run() {
     step_lanes(in, driven);
     stop_diverged(in, f, driven);
     measure(in);
+    if (!driven && in.t >= sc_.settle_from - 1e-9) track_return(in);
     snapshot(in, f, frames);
     if (opt_.on_frame) opt_.on_frame(f + 1, frames);
   }
@@ -854,15 +925,20 @@ std::vector<RunRecord> LockstepRun::run() {
     RunRecord& r = l.record;
     std::optional<std::pair<int, double>> stop;
     if (r.failure) stop = std::make_pair(r.failure->frame, r.failure->t);
+    verdict::Return back = l.back.result();
+    back.twin_frames = l.twin_frames;
+    if (l.twin.empty()) back.skipped_why = "no rest twin was run (RunOptions::twin off)";
     r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", stretch_of(l), l.settle.result(),
-                                l.probe, sc_.dt);
+                                l.probe, back, sc_.dt);
   }
   // Lane 0 is the reference: every deviation carries its verdict.
   const verdict::Verdict reference = lanes_[0].record.verdict;
+  const material::Card reference_card = lanes_[0].record.card;
   std::vector<RunRecord> out;
   for (Lane& l : lanes_) {
     RunRecord& r = l.record;
     r.reference_status = reference.status;
+    r.reference_card = reference_card;
     if (reference.status != verdict::Status::ok) r.reference_reason = reference.reason;
     if (l.reported) out.push_back(std::move(r));
   }

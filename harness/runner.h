@@ -52,6 +52,10 @@ struct SubstepsChoice {
 // Empty for a model without a step bound.
 std::optional<SubstepsChoice> choose_substeps(const ModelInfo& model, const Scenario& scenario,
                                               const ParamSet& resolved, const std::vector<ParamOverride>& overrides);
+// Sets `substeps` to what choose_substeps picks where it picks automatically (after a
+// change to the parameters the bound reads: --calibrate's fitted stiffness).
+void apply_auto_substeps(const ModelInfo& model, const Scenario& scenario, ParamSet& params,
+                         const std::vector<ParamOverride>& overrides);
 nlohmann::json substeps_json(const SubstepsChoice& c);
 
 struct RunOptions {
@@ -75,6 +79,14 @@ struct RunOptions {
   // verdict; a model whose probe grows never sleeps. Off only where a test or benchmark
   // needs bare steps.
   bool probe = true;
+  // Each lane's rest twin (harness/twin.h), for the `deformed` verdict. Off only where a
+  // test or benchmark needs bare steps, or a caller reads no verdict but the
+  // self-excited classes.
+  bool twin = true;
+  // --calibrate (harness/calibrate.h): each reported model but the reference runs with its
+  // stiffness and damping fitted so that its material card matches the reference's.
+  // Parameters given in `overrides` or `model_overrides` are not fitted.
+  bool calibrate = false;
   // false (--no-skip): models run every stage even where it is inert and no strand
   // sleeps (ModelContext::skip_inert), to show what skipping saves and that it changes
   // nothing else.

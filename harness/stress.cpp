@@ -188,8 +188,8 @@ std::vector<Degenerate> degenerate_grooms(float r) {
 }
 
 // Runs `model` alone on sc: its verdict class and why, ok with "" when it held.
-// Any class but ok fails a stress value: a stretched strand is as much a limit of the
-// configuration as a diverged one.
+// Any class but ok fails a stress value: a stretched strand, or hair that does not return,
+// is as much a limit of the configuration as a diverged one.
 std::pair<verdict::Status, std::string> run_one(const Scenario& sc, const std::string& model,
                                                 const std::vector<ParamOverride>& overrides, ThreadPool& pool) {
   RunOptions opt;
@@ -428,7 +428,9 @@ nlohmann::json stress_json(const StressResult& r) {
            "any verdict but ok (docs/verdicts.md): diverged (NaN/Inf; a vertex farther than 10 mean strand "
            "lengths from the head; mechanical energy rising by > 5% g L-bar per 10-frame window for 60 frames with "
            "the head still), unstable (a perturbation at rest growing faster than 1/s, or motion not decaying with "
-           "the head still), stretched (an edge more than 50% of its strand's median rest edge off its rest length)"},
+           "the head still), deformed (at the end more than 0.1 mean strand lengths RMS from where the model rests with the "
+           "head held still at the final pose), stretched (an edge more than 50% of its strand's median rest edge off "
+           "its rest length)"},
           {"axes", axes},
           {"degenerate", degenerate}};
 }

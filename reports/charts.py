@@ -56,7 +56,7 @@ except ImportError as e:  # the CLI turns exit 3 into "install python3-matplotli
     sys.exit(3)
 
 # Runs whose verdict is not ok, on the time-vs-error chart (docs/verdicts.md).
-STATUS_MARKERS = {"stretched": "s", "unstable": "X"}
+STATUS_MARKERS = {"stretched": "s", "deformed": "D", "unstable": "X"}
 PHASE_COLOURS = {"move": "tab:blue", "oscillate": "tab:orange", "wind": "tab:green"}
 # Stages in the order a step runs them: the order of core/stage.h's name table.
 STAGE_ORDER = ["upload", "dispatch", "references", "pose", "integrate", "global_shape", "local_shape", "length",
@@ -286,7 +286,7 @@ def chart_time_vs_error(report, out_dir, stem, written, svg):
     fig, axes = grid(len(split))
     panels = []
     for ax, (name, machine, runs) in zip(axes, split):
-        # Every run that went to the end is drawn; a stretched or unstable one is marked (its
+        # Every run that went to the end is drawn; a stretched, deformed or unstable one is marked (its
         # numbers are real, its behaviour is not what the method promises). A run that
         # diverged has no comparable numbers and is named in the corner.
         stable = []
@@ -664,7 +664,8 @@ def chart_strands(report, out_dir, stem, written, svg):
 # --- tables -----------------------------------------------------------------------------
 
 COLUMNS = ["model", "knob", "status", "median step ms", "ns/vertex", "deviation RMS", "deviation max",
-           "jaggedness mean", "length error RMS", "rest shape error", "penetration max (m)", "Pareto"]
+           "jaggedness mean", "length error RMS", "rest shape error", "penetration max (m)", "Pareto",
+           "material card (vs reference)"]
 
 
 def table_rows(report, name, pareto):
@@ -679,7 +680,7 @@ def table_rows(report, name, pareto):
                      fmt(r["timing"]["ns_per_vertex"], ".1f"), fmt(m["deviation_vs_reference"]["rms"]),
                      fmt(m["deviation_vs_reference"]["max"]), fmt(m["jaggedness"]["mean"]),
                      fmt(m["length_error"]["rms"], ".2g"), fmt(m["rest_shape_error"]),
-                     fmt(m["penetration"]["max"], ".2g"), "yes" if on_front else ""])
+                     fmt(m["penetration"]["max"], ".2g"), "yes" if on_front else "", card_text(r) or "–"])
     return rows
 
 
@@ -790,16 +791,31 @@ def overview(report):
                 "speed": t / ref_t if ref_t > 0 and math.isfinite(t) and (mix or not other) else float("nan"),
                 "deviation": num(r["metrics"]["deviation_vs_reference"]["rms"]),
                 "jaggedness": num(r["metrics"]["jaggedness"]["mean"]),
+                "card": card_text(r),
             }
     return rows, names, cells
 
 
+def card_text(run):
+    """The run's material card beside the reference's (docs/metrics.md, The material card):
+    each number over the reference's ("sag ×0.42 σ ×0.31 ω ×0.79"), or the reference's
+    own numbers on its own run; "" for a report without cards."""
+    m = run["metrics"].get("material")
+    if not m or "skipped" in m:
+        return ""
+    ratios = m.get("vs_reference")
+    own = run["metrics"]["deviation_vs_reference"]["max"] == 0
+    if ratios and not own:
+        return " ".join(f"{k} ×{fmt(ratios[key], '.2g')}" for k, key in (("sag", "sag"), ("σ", "sigma"), ("ω", "omega")))
+    return f"sag {fmt(m['sag'], '.2g')} σ {fmt(m['sigma'], '.2g')}/s ω {fmt(m['omega'], '.2g')}/s"
+
+
 DEV_NORM = matplotlib.colors.LogNorm(vmin=1e-4, vmax=1.0)
-STATUS_COLOURS = {"stretched": "#fbe99a", "unstable": "#f9b56b", "diverged": "#ef8a8a"}
+STATUS_COLOURS = {"stretched": "#fbe99a", "deformed": "#dcc3ee", "unstable": "#f9b56b", "diverged": "#ef8a8a"}
 
 
 def cell_colour(c):
-    """A verdict other than ok in its own warm colour (yellow, orange, red); an ok run's
+    """A verdict other than ok in its own colour (yellow, lilac, orange, red); an ok run's
     deviation on a log scale, 1e-4 L̄ (white) to 1 L̄ (blue), so that no deviation can be
     mistaken for a verdict; the reference itself pale grey."""
     if c["status"] in STATUS_COLOURS:
@@ -818,8 +834,11 @@ def overview_html(report):
     rows, names, cells = overview(report)
     out = ["<h2 id='overview'>Overview</h2>",
            "<p>Each cell: verdict; median step time relative to the reference model's run in that scenario "
-           "(×, lower is faster); deviation from the reference (RMS over frames, / L̄); jaggedness (mean). "
-           "Colour: yellow stretched, orange unstable, red diverged (docs/verdicts.md); an ok run's deviation on a "
+           "(×, lower is faster); deviation from the reference (RMS over frames, / L̄); jaggedness (mean); the "
+           "material card over the reference's: static sag, and the slowest mode's decay rate σ and frequency ω "
+           "(docs/metrics.md; on the reference's own run its numbers). "
+           "Colour: yellow stretched, lilac deformed, orange unstable, red diverged (docs/verdicts.md); an ok run's "
+           "deviation on a "
            "log scale from 10⁻⁴ (white) to 1 (blue); grey: the reference itself.</p>",
            "<table class='overview'><tr><th>model</th>" + "".join(f"<th>{e(n)}</th>" for n in names) + "</tr>"]
     for row in rows:
@@ -834,8 +853,9 @@ def overview_html(report):
             speed = "–" if not math.isfinite(v) else f"×{v:.0f}" if v >= 10 else f"×{v:.2g}"
             if c["other_machine"]:
                 speed += " (other machines)" if math.isfinite(v) else " (timed on another machine)"
+            card = f"<br><small>{e(c['card'])}</small>" if c["card"] else ""
             tds.append(f"<td style='background:{cell_colour(c)}'><b>{e(verdict)}</b><br>{e(speed)}<br>"
-                       f"dev {e(fmt(c['deviation'], '.2g'))}<br>jag {e(fmt(c['jaggedness'], '.2g'))}</td>")
+                       f"dev {e(fmt(c['deviation'], '.2g'))}<br>jag {e(fmt(c['jaggedness'], '.2g'))}{card}</td>")
         out.append("<tr>" + "".join(tds) + "</tr>")
     out.append("</table>")
     return out

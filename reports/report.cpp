@@ -265,7 +265,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
       {"stage_ms", stage},
       {"stage_skipped_steps", r.stage_skipped_steps},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))},
-      {"overhead_s", {{"probe", r.probe_s}, {"setup", r.setup_s}, {"settle_extra", r.settle_extra_s}}}};
+      {"overhead_s", {{"probe", r.probe_s}, {"twin", r.twin_s}, {"setup", r.setup_s}, {"settle_extra", r.settle_extra_s}}}};
 
   if (r.stream_ms > 0.0) {
     timing["state_bytes"] = r.state_bytes;
@@ -294,6 +294,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
       {"jaggedness", {{"mean", num(finite_mean(r.jaggedness))}, {"max", num(finite_max(r.jaggedness))}}},
       {"length_error", {{"rms", num(rms(r.length_rms))}, {"max", num(finite_max(r.length_max))}}},
       {"rest_shape_error", num(finite_mean(settled))},
+      {"material", material::card_json(r.card, &r.reference_card)},
       {"penetration", {{"max", num(finite_max(r.penetration))}}},
       {"state_hash", metrics::hash_hex(r.state_hash)}};
   // Follow hairs are rebuilt from their guides and not collided (as TressFX does not):
@@ -342,6 +343,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
                        {"snapshots", std::move(snapshots)}};
   if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
   if (!r.substeps.is_null()) out["substeps"] = r.substeps;
+  if (r.calibration) out["calibration"] = material::calibration_json(*r.calibration);
   if (!r.penetration_follow.empty()) {
     out["series"]["penetration_guides"] = series(r.penetration_guides);
     out["series"]["penetration_follow"] = series(r.penetration_follow);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.h"
+#include "reports/material.h"
 #include "reports/verdict.h"
 
 #include <nlohmann/json.hpp>
@@ -45,6 +46,9 @@ struct RunRecord {
   // a deviation is a measure of accuracy only against a reference that is `ok`.
   verdict::Status reference_status = verdict::Status::ok;
   std::string reference_reason;  // the reference's verdict reason when it is not ok
+  // The run's material card and the reference's on this scenario (reports/material.h).
+  material::Card card, reference_card;
+  std::optional<material::Calibration> calibration;  // what --calibrate fitted
   // Per frame actually run (a failed run stops early).
   std::vector<double> step_ms;
   // Per frame run: 1 where the model worked (the head moved, wind blew, or some strand was
@@ -75,7 +79,7 @@ struct RunRecord {
   // Wall time outside the timed steps that is the model's own work: its perturbation probe
   // at rest, making and resetting it, and the frames stepped past the scenario's end for
   // the settle check (timing.overhead_s).
-  double probe_s = 0.0, setup_s = 0.0, settle_extra_s = 0.0;
+  double probe_s = 0.0, twin_s = 0.0, setup_s = 0.0, settle_extra_s = 0.0;
 
   // Parameters given to the reference on top of the scenario's (--reference converged);
   // empty when the reference runs at the scenario's parameters.

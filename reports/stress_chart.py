@@ -69,16 +69,17 @@ def main(argv):
         r, c = models.index(d["model"]), grooms.index(d["groom"])
         # the verdict classes (docs/verdicts.md) and "refused" at load; stress.json files
         # written before the classes existed call a blow-up "unstable" too
-        dgrid[r][c] = {"ok": 1.0, "stretched": 0.75, "refused": 0.5, "unstable": 0.25, "diverged": 0.0}[d["status"]]
+        dgrid[r][c] = {"ok": 1.0, "stretched": 0.8, "deformed": 0.6, "refused": 0.4, "unstable": 0.2,
+                       "diverged": 0.0}[d["status"]]
         bottom.text(c, r, d["status"], ha="center", va="center", fontsize=6)
-    bottom.imshow(dgrid, cmap=ListedColormap(["#e06666", "#f6b26b", "#ffd966", "#fff2cc", "#93c47d"]),
+    bottom.imshow(dgrid, cmap=ListedColormap(["#e06666", "#f6b26b", "#ffd966", "#dcc3ee", "#fff2cc", "#93c47d"]),
                   vmin=0, vmax=1, aspect="auto")
     bottom.set_yticks(range(len(models)))
     bottom.set_yticklabels(models, fontsize=6)
     bottom.set_xticks(range(len(grooms)))
     bottom.set_xticklabels(grooms, fontsize=6)
-    bottom.set_title("Degenerate grooms: ok (green), stretched, refused at load (yellow), unstable (orange) "
-                     "or diverged (red)", fontsize=8)
+    bottom.set_title("Degenerate grooms: ok (green), stretched (pale yellow), deformed (lilac), refused at load "
+                     "(yellow), unstable (orange) or diverged (red)", fontsize=8)
     fig.tight_layout()
     written = []
     for ext in ("png", "svg"):

@@ -9,6 +9,7 @@ std::string_view status_name(Status s) {
   switch (s) {
     case Status::ok: return "ok";
     case Status::stretched: return "stretched";
+    case Status::deformed: return "deformed";
     case Status::unstable: return "unstable";
     case Status::diverged: return "diverged";
   }
@@ -85,6 +86,48 @@ Settle SettleCheck::result() const {
   return s;
 }
 
+void ReturnTracker::add(double t, double distance) {
+  t_.push_back(t);
+  d_.push_back(distance);
+}
+
+void ReturnTracker::set_worst(std::uint32_t strand, double distance) {
+  worst_strand_ = strand;
+  worst_ = distance;
+}
+
+Return ReturnTracker::result() const {
+  Return r;
+  r.frames = static_cast<int>(d_.size());
+  if (d_.empty()) {
+    r.skipped_why = "no settle window (the head moves or wind blows to the end)";
+    return r;
+  }
+  r.measured = true;
+  r.first = d_.front();
+  r.last = d_.back();
+  r.worst_strand = worst_strand_;
+  r.worst = worst_;
+  // Least squares slope of ln(distance); a zero distance (a model that sleeps into its
+  // twin's state) has no logarithm and leaves the rate at 0.
+  double st = 0, sl = 0, stt = 0, stl = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < d_.size(); ++i) {
+    if (!(d_[i] > 0.0) || !std::isfinite(d_[i])) continue;
+    const double l = std::log(d_[i]);
+    st += t_[i];
+    sl += l;
+    stt += t_[i] * t_[i];
+    stl += t_[i] * l;
+    ++n;
+  }
+  const double den = n * stt - st * st;
+  if (n >= 2 && den > 0.0) r.rate = (n * stl - st * sl) / den;
+  // NaN (a state that is not finite) is not within the limit.
+  r.deformed = !(r.last <= Return::kLimit);
+  return r;
+}
+
 double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, const Affine3f& head,
                                const Affine3f& head_prev, double dt) {
   // Hair carried rigidly by the head scores 0, so a walk's steady translation is not
@@ -99,11 +142,12 @@ double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> 
 }
 
 Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::string& diverged, const Stretch& stretch,
-               const Settle& settle, const Probe& probe, double dt) {
+               const Settle& settle, const Probe& probe, const Return& back, double dt) {
   Verdict v;
   v.stretch = stretch;
   v.settle = settle;
   v.probe = probe;
+  v.back = back;
   char buf[200];
   if (stop) {
     v.status = Status::diverged;
@@ -126,6 +170,19 @@ Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::str
                     settle.extra_frames * dt);
       v.reason += buf;
     }
+  } else if (back.measured && back.deformed) {
+    v.status = Status::deformed;
+    std::snprintf(buf, sizeof buf,
+                  "does not return: %.3g mean strand lengths (RMS) from where it rests with the head held still at "
+                  "this pose, strand %u %.3g; ",
+                  back.last, back.worst_strand, back.worst);
+    v.reason = buf;
+    if (back.rate < 0.0)
+      std::snprintf(buf, sizeof buf, "coming back at %.3g/s (e-folding time %.3g s) over the last %.3g s", back.rate,
+                    -1.0 / back.rate, back.frames * dt);
+    else
+      std::snprintf(buf, sizeof buf, "not coming back (%.3g/s over the last %.3g s)", back.rate, back.frames * dt);
+    v.reason += buf;
   } else if (stretch.frames_above > 0) {
     v.status = Status::stretched;
     std::snprintf(buf, sizeof buf, "edge length error %.3g (strand %u, edge %u%s) above %.2g in %d frames",
@@ -181,6 +238,18 @@ nlohmann::json verdict_json(const Verdict& v) {
                                                         {"strand", v.settle.spread.strand},
                                                         {"guides", v.settle.spread.guides},
                                                         {"share", num(v.settle.spread.share)}}}}}};
+  if (v.back.measured)
+    j["return"] = {{"limit", Return::kLimit},
+                   {"frames", v.back.frames},
+                   {"twin_frames", v.back.twin_frames},
+                   {"first", num(v.back.first)},
+                   {"last", num(v.back.last)},
+                   {"rate", num(v.back.rate)},
+                   {"worst_strand", v.back.worst_strand},
+                   {"worst", num(v.back.worst)},
+                   {"deformed", v.back.deformed}};
+  else
+    j["return"] = {{"skipped", v.back.skipped_why}};
   if (v.probe.run)
     j["probe"] = {{"kick", num(v.probe.kick)},
                   {"first", num(v.probe.first)},

@@ -1,4 +1,4 @@
-// Stability verdicts: what a run's motion says about the model, in four classes
+// Verdicts: what a run's motion says about the model, in five classes
 // (docs/verdicts.md). Each class has one detector here, fed frame by frame by the runner;
 // the detectors read positions only, so every model is judged by the same code.
 //
@@ -7,6 +7,9 @@
 //   unstable   self-excited motion: with the head still and no wind, motion relative to
 //              the head that does not decay (SettleCheck), or a tiny perturbation at rest
 //              that grows (the probe, harness/probe.h). The run goes on and is measured.
+//   deformed   the hair does not return: at the end of the settle window it is more than
+//              Return::kLimit from where the same model rests with the head held still at
+//              the run's final pose (Return). Measured, never a reason to stop.
 //   stretched  a constraint violated: some edge more than kStretchLimit longer or shorter
 //              than at rest (StretchTracker). Measured, never a reason to stop.
 //   ok         none of these.
@@ -27,7 +30,8 @@
 
 namespace hairbench::verdict {
 
-enum class Status { ok, stretched, unstable, diverged };
+// In rank order: a run gets the worst class any detector finds.
+enum class Status { ok, stretched, deformed, unstable, diverged };
 std::string_view status_name(Status s);
 
 // An edge error (metrics::length_error: relative to the strand's median rest edge) above
@@ -138,6 +142,46 @@ struct Probe {
   bool grows = false;
 };
 
+// Does the hair come back? The rest groom is not where a model's hair rests (it sags, and
+// a head tilted at the end hangs it another way), so the run's state is compared with a
+// twin: the same model at the same settings, started from the rest groom and held still
+// at the run's final head pose for as many frames as the run (harness/twin.h). The
+// distance is the RMS over vertices, in the head's frame, in mean strand lengths, taken
+// every frame of the settle window (the frames SettleCheck reads); its rate is the slope
+// of ln(distance) over them.
+struct Return {
+  // Above this RMS distance at the window's last frame, in mean strand lengths, the run is
+  // deformed. Measured on the default comparison (84 runs): every run but two ends within
+  // 0.035 of its twin (the Han methods within 1e-5; the cascade up to 0.034, returning at
+  // 1.2 to 1.7/s), and those two, the cascade on the TressFX ponytail's spin and on
+  // TestHair1, end 0.29 and 0.45 from it, returning with e-folding times of 2.5 and 2.9 s.
+  // 0.1 (1 cm on a 10 cm strand) is the geometric middle of that gap.
+  static constexpr double kLimit = 0.1;
+  bool measured = false;
+  std::string skipped_why;  // when not measured
+  int frames = 0;           // settle-window frames measured
+  int twin_frames = 0;      // frames the twin stepped before it stopped (harness/twin.h)
+  double first = 0.0, last = 0.0;  // distance at the window's first and last frame
+  double rate = 0.0;        // d ln(distance) / dt over the window, 1/s (< 0: coming back)
+  std::uint32_t worst_strand = 0;  // the strand farthest from its twin at the last frame
+  double worst = 0.0;              // its RMS distance, mean strand lengths
+  bool deformed = false;
+};
+
+// Accumulates Return over the settle window: one distance per frame.
+class ReturnTracker {
+ public:
+  void add(double t, double distance);
+  // The farthest strand of the latest frame.
+  void set_worst(std::uint32_t strand, double distance);
+  Return result() const;
+
+ private:
+  std::vector<double> t_, d_;
+  std::uint32_t worst_strand_ = 0;
+  double worst_ = 0.0;
+};
+
 // The verdict of one run.
 struct Verdict {
   Status status = Status::ok;
@@ -147,12 +191,13 @@ struct Verdict {
   Stretch stretch;
   Settle settle;
   Probe probe;
+  Return back;
 };
 
-// Combines the detectors: the worst class wins (diverged > unstable > stretched > ok).
-// `diverged` is the blow-up reason when the run stopped, with its frame and time.
+// Combines the detectors: the worst class wins (diverged > unstable > deformed > stretched
+// > ok). `diverged` is the blow-up reason when the run stopped, with its frame and time.
 Verdict decide(const std::optional<std::pair<int, double>>& stop, const std::string& diverged, const Stretch& stretch,
-               const Settle& settle, const Probe& probe, double dt);
+               const Settle& settle, const Probe& probe, const Return& back, double dt);
 
 nlohmann::json verdict_json(const Verdict& v);
 

@@ -257,6 +257,19 @@ def check_asleep(charts_py, golden, tmp):
     check("<b>asleep</b>" in page, "asleep: the overview says so")
 
 
+def run_doctored(charts_py, rep, tmp, name):
+    """Charts a report changed in memory (written to its own folder, charted into
+    another): the manifest and the output stem."""
+    src, out = os.path.join(tmp, name + "_src"), os.path.join(tmp, name)
+    os.makedirs(src)
+    os.makedirs(out)
+    doctored = os.path.join(src, name + ".json")
+    with open(doctored, "w") as f:
+        json.dump(rep, f)
+    _, m, stem = run_on(charts_py, doctored, out)
+    return m, stem
+
+
 def check_unsound_reference(charts_py, golden, tmp):
     """A scenario whose reference is not ok: its deviations are no accuracy, so its panel
     has no Pareto front and the overview says why; the other scenarios keep theirs."""
@@ -267,13 +280,7 @@ def check_unsound_reference(charts_py, golden, tmp):
         if r["scenario"] == name:
             r["metrics"]["deviation_vs_reference"].update(
                 {"reference_status": "unstable", "reference_reason": "motion does not decay (test)"})
-    src, out = os.path.join(tmp, "unsound_src"), os.path.join(tmp, "unsound")
-    os.makedirs(src)
-    os.makedirs(out)
-    doctored = os.path.join(src, "unsound_reference.json")
-    with open(doctored, "w") as f:
-        json.dump(rep, f)
-    _, m, stem = run_on(charts_py, doctored, out)
+    m, stem = run_doctored(charts_py, rep, tmp, "unsound_reference")
     panels = {p["scenario"]: p for p in m["charts"]["time_vs_error"]["panels"]}
     check(panels[name]["pareto"] == [], f"unsound reference: {name} still has a Pareto front")
     others = [n for n in panels if n != name]
@@ -281,6 +288,41 @@ def check_unsound_reference(charts_py, golden, tmp):
     summary = open(f"{stem}_summary.md", encoding="utf-8").read()
     check("the reference is unstable here (motion does not decay (test))" in summary,
           "unsound reference: the overview says so")
+
+
+def check_deformed(charts_py, golden, tmp):
+    """A run that does not return (docs/verdicts.md, deformed): marked on the time-vs-error
+    chart, never on its Pareto front, and its overview cell lilac with its class."""
+    with open(golden) as f:
+        rep = json.load(f)
+    run = next(r for r in rep["runs"] if r["metrics"]["deviation_vs_reference"]["rms"] not in (0, None))
+    run["status"] = "deformed"
+    run["verdict"]["class"] = "deformed"
+    run["verdict"]["reason"] = "does not return: 0.3 mean strand lengths (test)"
+    m, stem = run_doctored(charts_py, rep, tmp, "deformed")
+    panel = next(p for p in m["charts"]["time_vs_error"]["panels"] if p["scenario"] == run["scenario"])
+    check(all(p["model"] != run["model"] for p in panel["pareto"]), f"deformed: {run['model']} on the Pareto front")
+    page = open(f"{stem}.html", encoding="utf-8").read()
+    check("background:#dcc3ee'><b>deformed" in page, "deformed: the overview cell is not lilac with its class")
+
+
+def check_material(charts_py, golden, tmp):
+    """The material card (docs/metrics.md): each run's numbers over the reference's in its
+    overview cell and its table row; the reference's own run shows its numbers."""
+    with open(golden) as f:
+        rep = json.load(f)
+    for r in rep["runs"]:
+        own = r["metrics"]["deviation_vs_reference"]["max"] == 0
+        r["metrics"]["material"] = {"strands": 8, "settle_s": 1.5, "sag": 0.08, "stretch": 0.01, "sigma": 35.0,
+                                    "omega": 54.0}
+        if not own:
+            r["metrics"]["material"]["vs_reference"] = {"sag": 0.42, "stretch": 1.0, "sigma": 0.31, "omega": 0.79}
+    m, stem = run_doctored(charts_py, rep, tmp, "material")
+    page = open(f"{stem}.html", encoding="utf-8").read()
+    check("sag ×0.42 σ ×0.31 ω ×0.79" in page, "material: the ratios are not in the overview")
+    check("sag 0.08 σ 35/s ω 54/s" in page, "material: the reference's own card is not shown")
+    summary = open(f"{stem}_summary.md", encoding="utf-8").read()
+    check("| sag ×0.42 σ ×0.31 ω ×0.79 |" in summary, "material: the ratios are not in the summary table")
 
 
 def check_svg(charts_py, golden, tmp):
@@ -335,6 +377,8 @@ def main():
         guarded("--svg", check_svg, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("unsound reference", check_unsound_reference, charts_py, os.path.join(data, "compare_report.json"),
                 tmp)
+        guarded("material", check_material, charts_py, os.path.join(data, "compare_report.json"), tmp)
+        guarded("deformed", check_deformed, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("bad report", check_bad, charts_py, tmp)
         guarded("stress", check_stress, os.path.join(os.path.dirname(charts_py), "stress_chart.py"),
                 os.path.join(data, "stress_small.json"), tmp)

@@ -74,7 +74,7 @@ TEST(Cli, VersionNamesTheBuiltCommit) {
 TEST(Cli, HelpNamesEveryOption) {
   const std::vector<std::string> run_options = {"--scenario", "--models",  "--reference", "--frames", "--threads",
                                                 "--set",      "--out",     "--no-charts", "--device", "--no-skip",
-                                                "--shard",    "--plan",    "--costs",     "--preset"};
+                                                "--shard",    "--plan",    "--costs",     "--preset",  "--calibrate"};
   std::vector<std::string> sweep_options = run_options;
   sweep_options.push_back("--knob");
   struct Help {

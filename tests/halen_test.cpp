@@ -970,7 +970,11 @@ TEST(HalenNodes, NodesNeverOutnumberTheGroomsVertices) {
     RunOptions opt;
     opt.models = {model};
     const RunRecord r = run_scenario(sc, opt, pool).front();
-    EXPECT_EQ(r.verdict.status, verdict::Status::ok) << model << ": " << r.verdict.reason;
+    EXPECT_EQ(r.verdict.stretch.frames_above, 0) << model << ": " << r.verdict.reason;
+    // The cascade comes back slowly on TestHair1 (e-folding time near 3 s, docs/verdicts.md
+    // "deformed"); the other two are ok.
+    const verdict::Status expected = model == "halen_cascade" ? verdict::Status::deformed : verdict::Status::ok;
+    EXPECT_EQ(verdict::status_name(r.verdict.status), verdict::status_name(expected)) << model << ": " << r.verdict.reason;
     EXPECT_EQ(r.params["nodes"], 4.0) << model << ": the report shows the count the model ran at";
   }
 }

@@ -73,8 +73,13 @@ TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
       // inside the collider out onto its surface (§4.2), wrapping the skeleton round it;
       // its bending springs then throw it off within a frame, and the strands rebuilt on
       // the skeleton folded over pass the 50% bound for a few frames
-      // (docs/limitations.md). It settles, never blows up.
-      EXPECT_TRUE(d.status == "ok" || d.status == "stretched") << d.status;
+      // (docs/limitations.md). It settles, never blows up, but not where its rest twin
+      // does: pushed off the collider the other way, it rests there (deformed).
+      EXPECT_TRUE(d.status == "ok" || d.status == "stretched" || d.status == "deformed") << d.status;
+    } else if (d.model.rfind("halen_cascade", 0) == 0 && (d.name == "two_vertex_strands" || d.name == "inside_collider")) {
+      // The cascade comes back, but slower than the short base scenario's half-second
+      // window (e-folding times of 2.4 s and 18 s, docs/limitations.md): deformed.
+      EXPECT_TRUE(d.status == "ok" || d.status == "deformed") << d.status;
     } else {
       EXPECT_EQ(d.status, "ok");  // these are valid grooms: every model must cope
     }

@@ -3,11 +3,14 @@
 
 #include <cstdio>
 
+#include "core/groom_fit.h"
 #include "core/parallel.h"
 #include "harness/runner.h"
 #include "scenarios/scenario.h"
+#include "scenarios/tfx/tfx.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -48,6 +51,20 @@ inline std::vector<RunRecord> run(const Scenario& sc, std::vector<std::string> m
   opt.overrides = std::move(overrides);
   opt.frames = frames;
   return run_scenario(sc, opt, pool);
+}
+
+// Guide `s` of an imported scenario's asset as the file authors it, before import hygiene
+// (repair_groom), written over strand `index` of `g` (a groom in the scenario's frame): read
+// from the file, in metres, moved by the import's translation (the root, which no repair
+// moves).
+inline void restore_authored_guide(const Scenario& sc, Groom& g, std::uint32_t s, std::uint32_t index) {
+  const Groom file = tfx::read_tfx_strands(sc.import->file);
+  const float scale = metres_per_unit(sc.import->unit);
+  const std::uint32_t fb = file.strand_begin(s), b = g.strand_begin(index);
+  if (file.strand_size(s) != g.strand_size(index)) throw std::runtime_error("restore_authored_guide: sizes differ");
+  const Vec3f shift = g.positions[b].head<3>() - scale * file.positions[fb].head<3>();
+  for (std::uint32_t i = 0; i < file.strand_size(s); ++i)
+    g.positions[b + i].head<3>() = scale * file.positions[fb + i].head<3>() + shift;
 }
 
 inline const RunRecord& find(const std::vector<RunRecord>& runs, const std::string& model) {

@@ -112,6 +112,26 @@ TEST(StretchTracker, PeakWorstStrandAndFramesAbove) {
   EXPECT_EQ(r.frames_above, 2);
 }
 
+// The distance from the rest twin over the settle window: its last value decides, its
+// slope in log space is the rate of return.
+TEST(Verdict, ReturnFitsTheRateAndComparesTheLastDistanceWithTheLimit) {
+  verdict::ReturnTracker coming;
+  for (int f = 0; f < 60; ++f) coming.add(f * kDt, 0.5 * std::exp(-0.1 * f * kDt));
+  coming.set_worst(3, 0.9);
+  const verdict::Return r = coming.result();
+  EXPECT_TRUE(r.measured);
+  EXPECT_NEAR(r.rate, -0.1, 1e-9);
+  EXPECT_TRUE(r.deformed);
+  EXPECT_EQ(r.worst_strand, 3u);
+  verdict::ReturnTracker back;
+  for (int f = 0; f < 60; ++f) back.add(f * kDt, verdict::Return::kLimit * (f < 59 ? 2.0 : 0.99));
+  EXPECT_FALSE(back.result().deformed);
+  verdict::ReturnTracker nan;
+  nan.add(0.0, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_TRUE(nan.result().deformed);
+  EXPECT_FALSE(verdict::ReturnTracker().result().measured);
+}
+
 TEST(Verdict, TheWorstClassWins) {
   verdict::Stretch stretched;
   stretched.frames_above = 3;
@@ -122,17 +142,29 @@ TEST(Verdict, TheWorstClassWins) {
   verdict::Probe grows;
   grows.run = grows.grows = true;
   grows.rate = 7.0;
-  EXPECT_EQ(verdict::decide({}, "", {}, {}, {}, kDt).status, Status::ok);
-  const verdict::Verdict s = verdict::decide({}, "", stretched, {}, {}, kDt);
+  EXPECT_EQ(verdict::decide({}, "", {}, {}, {}, {}, kDt).status, Status::ok);
+  const verdict::Verdict s = verdict::decide({}, "", stretched, {}, {}, {}, kDt);
   EXPECT_EQ(s.status, Status::stretched);
   EXPECT_EQ(s.frame, 9);
   EXPECT_NE(s.reason.find("0.7"), std::string::npos) << s.reason;
-  EXPECT_EQ(verdict::decide({}, "", stretched, flutter, {}, kDt).status, Status::unstable);
-  const verdict::Verdict u = verdict::decide({}, "", stretched, {}, grows, kDt);
+  EXPECT_EQ(verdict::decide({}, "", stretched, flutter, {}, {}, kDt).status, Status::unstable);
+  const verdict::Verdict u = verdict::decide({}, "", stretched, {}, grows, {}, kDt);
   EXPECT_EQ(u.status, Status::unstable);
   EXPECT_NE(u.reason.find("grows at 7/s"), std::string::npos) << u.reason;
+  // Does not return: above stretched, below unstable.
+  verdict::Return bent;
+  bent.measured = bent.deformed = true;
+  bent.last = 0.4;
+  bent.rate = -0.05;
+  bent.frames = 60;
+  const verdict::Verdict b = verdict::decide({}, "", stretched, {}, {}, bent, kDt);
+  EXPECT_EQ(b.status, Status::deformed);
+  EXPECT_NE(b.reason.find("does not return: 0.4 mean strand lengths"), std::string::npos) << b.reason;
+  EXPECT_NE(b.reason.find("e-folding time 20 s"), std::string::npos) << b.reason;
+  EXPECT_EQ(verdict::decide({}, "", {}, flutter, {}, bent, kDt).status, Status::unstable);
+  EXPECT_EQ(verdict::verdict_json(b)["return"]["last"], 0.4);
   const verdict::Verdict d = verdict::decide(std::make_pair(4, 5 * kDt), "non-finite position", stretched, flutter,
-                                             grows, kDt);
+                                             grows, bent, kDt);
   EXPECT_EQ(d.status, Status::diverged);
   EXPECT_EQ(d.frame, 4);
   EXPECT_EQ(d.reason, "non-finite position");
@@ -287,18 +319,6 @@ Scenario ponytail_guides(std::uint32_t fold, std::uint32_t& fold_index) {
   return sc;
 }
 
-// Guide `s` of the scenario as the asset authors it, before import hygiene: read from the
-// file, in metres, moved by the import's translation (the root, which no repair moves).
-void restore_authored_guide(Scenario& sc, std::uint32_t s, std::uint32_t index) {
-  const Groom file = tfx::read_tfx_strands(sc.import->file);
-  const float scale = metres_per_unit(sc.import->unit);
-  const std::uint32_t fb = file.strand_begin(s), b = sc.groom.strand_begin(index);
-  ASSERT_EQ(file.strand_size(s), sc.groom.strand_size(index));
-  const Vec3f shift = sc.groom.positions[b].head<3>() - scale * file.positions[fb].head<3>();
-  for (std::uint32_t i = 0; i < file.strand_size(s); ++i)
-    sc.groom.positions[b + i].head<3>() = scale * file.positions[fb + i].head<3>() + shift;
-}
-
 // The shortest edge of a strand over its median edge.
 double shortest_edge_ratio(const Groom& g, std::uint32_t s) {
   std::vector<double> e;
@@ -321,7 +341,7 @@ TEST(Verdict, MethodOneFluttersOnTheFoldedPonytailGuideAsAuthoredAndRestsOnTheRe
   std::uint32_t fold = 0;
   Scenario repaired = ponytail_guides(106, fold);
   Scenario authored = repaired;
-  restore_authored_guide(authored, 106, fold);
+  test::restore_authored_guide(authored, authored.groom, 106, fold);
   ASSERT_LT(shortest_edge_ratio(authored.groom, fold), kShortEdge) << "the premise: the authored fold's short edge";
   ASSERT_GE(shortest_edge_ratio(repaired.groom, fold), kShortEdge);
 
@@ -338,6 +358,52 @@ TEST(Verdict, MethodOneFluttersOnTheFoldedPonytailGuideAsAuthoredAndRestsOnTheRe
 
   const RunRecord fixed = test::run(repaired, {"han_m1"}).at(0);
   EXPECT_EQ(fixed.verdict.status, Status::ok) << fixed.verdict.reason;
+}
+
+// Does the hair come back (verdict::Return)? TestHair1's guides, every 8th, through their
+// built-in motion: the cascade, whose reference springs return it slowly, ends far from
+// where it rests with the head held still at the final pose, and coming back; the spring
+// model and method 1 return. Each is measured against its own twin, so their different
+// sags are not a deformation.
+TEST(Verdict, HairThatDoesNotReturnIsDeformedWithItsDistanceAndRate) {
+  Scenario sc = load_scenario(find_scenario("tressfx_testhair1"));
+  sc.groom = every_nth_strand(sc.follow ? sc.guides : sc.groom, 8);
+  sc.follow.reset();
+  const std::vector<RunRecord> runs = test::run(sc, {"han_m1", "halen_spring", "halen_cascade"});
+  for (const RunRecord& r : runs) {
+    SCOPED_TRACE(r.model);
+    const verdict::Return& back = r.verdict.back;
+    ASSERT_TRUE(back.measured) << back.skipped_why;
+    EXPECT_GT(back.frames, 20);
+    EXPECT_GT(back.twin_frames, 0);
+    RecordProperty(r.model + "_return", test::sci(back.last));
+    if (r.model == "halen_cascade") {
+      EXPECT_EQ(verdict::status_name(r.verdict.status), "deformed") << r.verdict.reason;
+      EXPECT_GT(back.last, 2 * verdict::Return::kLimit);
+      EXPECT_LT(back.last, back.first);
+      EXPECT_LT(back.rate, 0.0);
+      EXPECT_NE(r.verdict.reason.find("does not return"), std::string::npos) << r.verdict.reason;
+      EXPECT_NE(r.verdict.reason.find("coming back at"), std::string::npos) << r.verdict.reason;
+    } else {
+      EXPECT_EQ(verdict::status_name(r.verdict.status), "ok") << r.verdict.reason;
+      EXPECT_LT(back.last, verdict::Return::kLimit / 10);
+    }
+  }
+}
+
+// The twin steps in the head's frame at the final pose. Upside down, gravity there points
+// the other way from the head's, and a model whose forces are fixed to the head (the
+// spring model's tilt weakening, §4.4) must see the head as tilted
+// (FrameInput::rest_gravity), or its twin is another material: the spring model comes
+// back to its own twin on tilt_upside_down.
+TEST(Verdict, TheTwinOfAModelFixedToTheHeadSeesTheHeadTilted) {
+  const Scenario sc = test::builtin("tilt_upside_down", 16);
+  const std::vector<RunRecord> runs = test::run(sc, {"halen_spring", "halen_cascade", "han_m1"});
+  for (const RunRecord& r : runs) {
+    SCOPED_TRACE(r.model);
+    EXPECT_EQ(verdict::status_name(r.verdict.status), "ok") << r.verdict.reason;
+    EXPECT_LT(r.verdict.back.last, 1e-3);
+  }
 }
 
 // The ponytail ties 517 guides at the tip (inverse mass 0 at vertex 15). The forest, a tree

@@ -27,9 +27,9 @@ inline constexpr std::array<ParamSpec, 10> kParams{{
      "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; stiffness is given at 8 nodes and scales as ((nodes - 1) / 7)^3.6"},
     {"damping", 0.03, 0.0, 1.0, false,
      "fraction of velocity removed per sixth of a frame in Verlet (Eq. 4.1: k = 1 - damping), taken per "
-     "substep as the same per frame at any substep count"},
+     "substep as the same per frame at any substep count", ParamRole::damping},
     {"stiffness", 6000.0, 0.0, 1e6, false,
-     "k: upward reference spring strength at the root per unit node mass, s^-2 (§4.3, §5.9)"},
+     "k: upward reference spring strength at the root per unit node mass, s^-2 (§4.3, §5.9)", ParamRole::stiffness},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
     {"falloff_scale", 5.0, 0.0, 1e4, false,
      "c of §5.9, 1/m: the strength is k up to L = 1/c from the root, then falls as (L c)^-a"},

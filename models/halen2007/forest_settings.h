@@ -49,7 +49,7 @@ inline constexpr std::array<ParamSpec, 14> kParams{{
     {"nodes", 8, 2, 64, true,
      "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2"},
     {"joint_stiffness", 1100.0, 0.0, 1e6, false,
-     "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2"},
+     "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2", ParamRole::stiffness},
     {"joint_damping", 26.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
     {"falloff_scale", 5.0, 0.0, 1e4, false,
@@ -75,7 +75,7 @@ inline constexpr std::array<ParamSpec, 14> kParams{{
     {"drag", 2.0, 0.0, 1e3, false,
      "d, s^-1: each segment's rotation relative to the head decays at d (every joint's rates kept "
      "exp(-d dt) a step); not in §4.2, whose joint damping v reaches a strand's slowest swing as "
-     "v (π / 2n)² only"},
+     "v (π / 2n)² only", ParamRole::damping},
     {"rest_hold", 1, 0, 1, true,
      "with inertia 1: 1 a strand whose rest pose gravity would topple (upright segments) gets J = m L ℓ "
      "raised until its joints hold it under twice its weight (kernels::forest_rest_inertia_scale); 0 J as "

@@ -17,13 +17,13 @@ namespace hairbench::han {
 
 inline constexpr std::array<ParamSpec, 9> kParams{{
     {"damping", 0.03, 0.0, 1.0, false,
-     "fraction of velocity removed per (sub)step in Verlet (Halén Eq. 4.1: k = 1 - damping)"},
+     "fraction of velocity removed per (sub)step in Verlet (Halén Eq. 4.1: k = 1 - damping)", ParamRole::damping},
     {"global_stiffness", 0.2, 0.0, 1.0, false, "S_G of Eq. 2; 1 freezes hair to the rest shape"},
     {"global_range", 1.0, 0.0, 1.0, false,
      "fraction of each strand, from the root, that the global constraint acts on"},
     {"global_ramp", 1.0, 0.0, 1.0, true,
      "1: S_G falls linearly to 0 at the end of global_range (§3.3)"},
-    {"local_stiffness", 0.9, 0.0, 1.0, false, "S_L of Eq. 3-4"},
+    {"local_stiffness", 0.9, 0.0, 1.0, false, "S_L of Eq. 3-4", ParamRole::stiffness},
     // Up to a strand's most vertices (kMaxStrandVertices): method 2 (Algorithm 4) moves a
     // correction one vertex per iteration, so converging it on the longest strand takes that many.
     {"local_iterations", 1, 0, 256, true, "local shape constraint iterations per (sub)step"},

@@ -81,11 +81,11 @@ inline constexpr std::array<ParamSpec, 27> kParams{{
     {"integration_hz", 1000, 1, 100000, false, "explicit integration rate (§5.3: 1000 Hz)"},
     {"collision_hz", 120, 0, 100000, false, "wisp-body collision detection rate (§5.3: 120 Hz); 0 off"},
     {"interaction_hz", 24, 0, 100000, false, "wisp-wisp interaction detection rate (§5.3: 24 Hz); 0 off"},
-    {"air_drag", 5.0, 0, 1000, false, "air resistance on every mass, 1/s (§5.1 step 1)"},
+    {"air_drag", 5.0, 0, 1000, false, "air resistance on every mass, 1/s (§5.1 step 1)", ParamRole::damping},
     {"axial_stiffness", 4e5, 0, 1e7, false, "linear axial springs of the skeleton, 1/s^2 (§3.2)"},
     {"axial_damping", 40, 0, 1000, false, "damping of the axial springs, 1/s (§3.2)"},
     {"bending_stiffness", 1e5, 0, 1e6, false,
-     "bending springs: lateral acceleration = k * angle * segment rest length, 1/s^2 (§3.2)"},
+     "bending springs: lateral acceleration = k * angle * segment rest length, 1/s^2 (§3.2)", ParamRole::stiffness},
     {"bending_damping", 60, 0, 1000, false, "damping of the relative lateral velocity, 1/s (§3.2)"},
     {"bending", 1, 0, 1, true,
      "bending law: 0 paper (§3.2 as written: a spring on the angle between consecutive segments, towards its "

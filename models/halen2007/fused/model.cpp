@@ -416,6 +416,9 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
   if (spheres_.size() < nc * 4 * substep_.size()) spheres_.resize(nc * 4 * substep_.size());
   // §4.4: "z is the up vector, z_h the up vector of the head" — up is against gravity.
   const Vec3f up = in.gravity.squaredNorm() > 0.0f ? Vec3f(-in.gravity.normalized()) : Vec3f::UnitY();
+  // The head's up: the up of its rest orientation, turned by the head.
+  const Vec3f rest_gravity = in.gravity_at_rest();
+  const Vec3f rest_up = rest_gravity.squaredNorm() > 0.0f ? Vec3f(-rest_gravity.normalized()) : Vec3f::UnitY();
   for (int i = 1; i <= substeps_ && !forest; ++i) {
     const Affine3f head = interpolate_head(in.head_prev, in.head, static_cast<float>(i) / static_cast<float>(substeps_));
     soa::Substep& s = substep_[static_cast<std::size_t>(i - 1)];
@@ -426,7 +429,7 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
     s.dt2 = dt * dt;
     if (model_ == Model::Cascade) {  // as halen_cascade_ref's substep
       const k::Mat3f head_rotation = head.linear();
-      const Vec3f head_gravity = head_rotation * in.gravity;
+      const Vec3f head_gravity = head_rotation * in.gravity_at_rest();
       for (int c = 0; c < 3; ++c) s.hg[c] = head_gravity[c];
     }
     float* sp = spheres_.data() + static_cast<std::size_t>(i - 1) * nc * 4;
@@ -434,7 +437,7 @@ void HalenFusedModel::step(const FrameInput& in, StageTimes& times) {
     s.spheres = sp;
     s.sphere_count = static_cast<int>(nc);
     if (model_ == Model::Spring) {
-      const Vec3f head_up = head.linear() * up;
+      const Vec3f head_up = head.linear() * rest_up;
       for (std::size_t r = 0; r < region_.size(); ++r)
         spring_scale_[r * substep_.size() + static_cast<std::size_t>(i - 1)] =
             k::tilt_factor(up, head_up, region_[r].tilt_min);

@@ -90,7 +90,7 @@ void CascadeModel::step(const FrameInput& in, StageTimes& times) {
 void CascadeModel::substep(const Affine3f& head, const FrameInput& in, float dt, StageTimes& times) {
   const FramePlan plan = plan_frame(in, ctx_);
   const k::Mat3f head_rotation = head.linear();
-  const Vec3f head_gravity = head_rotation * in.gravity;
+  const Vec3f head_gravity = head_rotation * in.gravity_at_rest();
   {
     StageTimer t(times, Stage::References);
     for_each_strand([&](std::size_t s, const RegionSettings&) {

@@ -78,7 +78,10 @@ void SpringModel::substep(const Affine3f& head, const FrameInput& in, float dt, 
   const FramePlan plan = plan_frame(in, ctx_);
   // §4.4: "z is the up vector, z_h the up vector of the head" — up is against gravity.
   const Vec3f up = in.gravity.squaredNorm() > 0.0f ? Vec3f(-in.gravity.normalized()) : Vec3f::UnitY();
-  const Vec3f head_up = head.linear() * up;
+  // The head's up: the up of its rest orientation, turned by the head.
+  const Vec3f rest_gravity = in.gravity_at_rest();
+  const Vec3f rest_up = rest_gravity.squaredNorm() > 0.0f ? Vec3f(-rest_gravity.normalized()) : Vec3f::UnitY();
+  const Vec3f head_up = head.linear() * rest_up;
   {
     StageTimer t(times, Stage::References);
     for_each_strand([&](std::size_t s, const RegionSettings&) {
