@@ -109,54 +109,52 @@ ParamSet calibrate(const ModelInfo& info, const Scenario& sc, ParamSet params, c
     apply_auto_substeps(info, sc, p, given);
     return p;
   };
-  auto card = [&](const ParamSpec& spec, double factor, bool mode) {
-    return probe_at_rest(info, sc, scaled(spec, factor), pool, device, {false, mode}).card;
+  auto sag = [&](const ParamSpec& spec, double factor) {
+    return probe_at_rest(info, sc, scaled(spec, factor), pool, device, {false, false}).card.sag;
   };
-  const double sag_tolerance = std::max(kSagTolerance * std::abs(target.sag), kSagFloor);
-  for (const ParamRole role : {ParamRole::stiffness, ParamRole::damping}) {
-    material::Calibration::Fit f;
-    f.role = role == ParamRole::stiffness ? "stiffness" : "damping";
-    const ParamSpec* spec = with_role(info, role);
-    if (!spec) {
-      f.note = "the model marks no " + f.role + " parameter";
-      out.fits.push_back(f);
-      continue;
-    }
-    f.param = std::string(spec->name);
-    if (std::any_of(given.begin(), given.end(), [&](const ParamOverride& o) {
-          return o.name == spec->name && (o.model == "*" || o.model == info.name);
-        })) {
-      f.note = f.param + " is given on the command line: kept";
-      out.fits.push_back(f);
-      continue;
-    }
-    if (role == ParamRole::stiffness) {
-      f.on = "sag";
-      const double sag = card(*spec, 1.0, false).sag, softer = card(*spec, 0.25, false).sag;
-      f.evaluations = 2;
-      if (!(std::abs(softer - sag) > sag_tolerance)) {
-        f.on.clear();
-        f.note = "the sag does not answer " + f.param + " (" + text(sag) + " at its value, " + text(softer) +
-                 " at a quarter of it): left as it is";
-        out.fits.push_back(f);
-        continue;
-      }
-      fit({*spec, [&](double x) { return card(*spec, x, false).sag; }, target.sag,
-           [&](double v) { return std::abs(v - target.sag) <= sag_tolerance; },
-           [&](double v) { return std::isfinite(v) ? std::abs(v - target.sag) : HUGE_VAL; }},
-          params, f);
+  auto given_here = [&](const ParamSpec& spec) {
+    return std::any_of(given.begin(), given.end(), [&](const ParamOverride& o) {
+      return o.name == spec.name && (o.model == "*" || o.model == info.name);
+    });
+  };
+
+  material::Calibration::Fit stiffness;
+  stiffness.role = "stiffness";
+  const ParamSpec* spec = with_role(info, ParamRole::stiffness);
+  if (spec) stiffness.param = std::string(spec->name);
+  if (!spec) {
+    stiffness.note = "the model marks no stiffness parameter";
+  } else if (given_here(*spec)) {
+    stiffness.note = stiffness.param + " is given on the command line: kept";
+  } else {
+    const double tolerance = std::max(kSagTolerance * std::abs(target.sag), kSagFloor);
+    const double own = sag(*spec, 1.0), softer = sag(*spec, 0.25);
+    if (!(std::abs(softer - own) > tolerance)) {
+      stiffness.note = "the sag does not answer " + stiffness.param + " (" + text(own) + " at its value, " +
+                       text(softer) + " at a quarter of it): left as it is";
     } else {
-      // Not fitted: the card's decay rate moves with the frames it is read from, and fitted
-      // on it the damping made runs unstable or slow to return (docs/metrics.md,
-      // Calibration). The residual is the card's vs_reference.
-      f.note = "not fitted (the decay rate is reported, not matched): its residual is the card's sigma over "
-               "the reference's";
-      out.fits.push_back(f);
-      continue;
+      stiffness.on = "sag";
+      fit({*spec, [&](double x) { return sag(*spec, x); }, target.sag,
+           [&](double v) { return std::abs(v - target.sag) <= tolerance; },
+           [&](double v) { return std::isfinite(v) ? std::abs(v - target.sag) : HUGE_VAL; }},
+          params, stiffness);
+      if (stiffness.factor != 1.0) params = scaled(*spec, stiffness.factor);
     }
-    if (f.factor != 1.0) params = scaled(*spec, f.factor);
-    out.fits.push_back(f);
+    stiffness.evaluations += 2;
   }
+  out.fits.push_back(stiffness);
+
+  // The damping is not fitted: the card's decay rate moves with the frames it is read
+  // from, and fitted on it the damping made runs unstable or slow to return
+  // (docs/metrics.md, Calibration). Its residual is the card's vs_reference.sigma.
+  material::Calibration::Fit damping;
+  damping.role = "damping";
+  const ParamSpec* damper = with_role(info, ParamRole::damping);
+  damping.param = damper ? std::string(damper->name) : "";
+  damping.note = damper ? damping.param + " not fitted (the decay rate is reported, not matched): its residual is "
+                                          "the card's sigma over the reference's"
+                        : "the model marks no damping parameter";
+  out.fits.push_back(damping);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return params;
 }
