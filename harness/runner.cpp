@@ -432,13 +432,18 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   AtRest at_rest;
-  if (opt_.probe) at_rest = probe_at_rest(*info, sc_, params, pool_, opt_.device);
-  else at_rest.card.skipped_why = "not measured (the probe at rest is off)";
+  if (opt_.probe) at_rest = probe_at_rest(*info, sc_, params, pool_, opt_.device, {true, opt_.material_card});
+  if (!opt_.probe || !opt_.material_card) at_rest.card = {};
+  if (!opt_.probe) at_rest.card.skipped_why = "not measured (the probe at rest is off)";
+  else if (!opt_.material_card) at_rest.card.skipped_why = "not measured (RunOptions::material_card off)";
   const verdict::Probe& probe = at_rest.probe;
   const auto probed = Clock::now();
   const bool skip = opt_.skip_inert && !(probe.run && probe.grows);
+  // The twin sleeps even under --no-skip: it is the yardstick, not the measured run, and
+  // sleeping moves a state by less than 1e-4 L (docs/verdicts.md), a thousandth of the
+  // deformed limit. A model whose rest state is unstable never sleeps.
   RestTwin twin;
-  if (opt_.twin) twin = rest_twin(*info, sc_, params, pool_, opt_.device, skip, frames_);
+  if (opt_.twin) twin = rest_twin(*info, sc_, params, pool_, opt_.device, !(probe.run && probe.grows), frames_);
   const auto twinned = Clock::now();
   Lane lane{info, params, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
             metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe, std::move(twin.positions), twin.frames};

@@ -83,6 +83,10 @@ struct RunOptions {
   // test or benchmark needs bare steps, or a caller reads no verdict but the
   // self-excited classes.
   bool twin = true;
+  // Each lane's material card (reports/material.h: the probe's third, harder-kicked copy
+  // for the mode; sag and stretch cost nothing extra). Off where no report shows it
+  // (stress cells), and then `--calibrate` has no target.
+  bool material_card = true;
   // --calibrate (harness/calibrate.h): each reported model but the reference runs with its
   // stiffness and damping fitted so that its material card matches the reference's.
   // Parameters given in `overrides` or `model_overrides` are not fitted.

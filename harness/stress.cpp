@@ -196,6 +196,7 @@ std::pair<verdict::Status, std::string> run_one(const Scenario& sc, const std::s
   opt.models = {model};
   opt.reference = model;
   opt.overrides = overrides;
+  opt.material_card = false;  // stress.json shows verdicts only
   const std::vector<RunRecord> runs = run_scenario(sc, opt, pool);
   const verdict::Verdict& v = runs.front().verdict;
   if (v.status == verdict::Status::ok) return {v.status, {}};

@@ -36,7 +36,8 @@ inline constexpr double kTwinRestSpeed = 1e-4;
 inline constexpr int kTwinRestFrames = 10;
 
 // Steps the twin `frames` frames, or until it has stopped (kTwinRestSpeed), the model
-// made as the run's is (make_model, with its follow hairs and `skip_inert`).
+// made as the run's is (make_model, with its follow hairs); `skip_inert` lets its strands
+// sleep once they rest.
 RestTwin rest_twin(const ModelInfo& info, const Scenario& sc, const ParamSet& params, ThreadPool& pool,
                    const std::string& device, bool skip_inert, int frames);
 
