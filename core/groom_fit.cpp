@@ -10,8 +10,11 @@
 #include <cstring>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
+#include <utility>
 
 namespace hairbench {
 namespace {
@@ -59,6 +62,157 @@ Sphere3 lsq_sphere(const std::vector<Vec3d>& pts, const std::vector<char>& use, 
   return s;
 }
 
+double median(std::vector<double> v);
+
+// The centre of the sphere of radius r nearest the used points in least squares (Gauss-
+// Newton from c on sum (|p - c| - r)^2), for a consensus whose radius is held at a bound.
+Vec3d centre_at_radius(const std::vector<Vec3d>& pts, const std::vector<char>& use, Vec3d c, double r) {
+  for (int it = 0; it < 8; ++it) {
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Vec3d b = Vec3d::Zero();
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (!use[i]) continue;
+      const Vec3d v = pts[i] - c;
+      const double d = v.norm();
+      if (!(d > 0.0)) continue;
+      const Vec3d u = v / d;
+      a += u * u.transpose();
+      b += u * (d - r);
+    }
+    const Vec3d step = a.ldlt().solve(b);
+    if (!step.allFinite()) break;
+    c += step;
+    if (step.norm() <= 1e-9 * r) break;
+  }
+  return c;
+}
+
+// The RMS of |p - c| - r over the used points, and the length of their mean unit
+// direction from c (HeadFit::cap).
+std::pair<double, double> residual_and_cap(const std::vector<Vec3d>& pts, const std::vector<char>& use, const Vec3d& c,
+                                           double r) {
+  double sum = 0.0;
+  Vec3d dir = Vec3d::Zero();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!use[i]) continue;
+    const double d = (pts[i] - c).norm();
+    sum += (d - r) * (d - r);
+    if (d > 0.0) dir += (pts[i] - c) / d;
+    ++n;
+  }
+  if (n == 0) return {0.0, 0.0};
+  return {std::sqrt(sum / static_cast<double>(n)), (dir / static_cast<double>(n)).norm()};
+}
+
+// A consensus sphere with its radius held in [lo, hi] (fit_head, steps 1 and 2).
+struct Consensus {
+  Sphere3 s;
+  std::vector<char> in;  // the roots within kFitBand r of it
+  std::size_t count = 0;
+  bool at_bound = false;  // its radius is held at lo or hi: the roots want another size
+};
+
+std::vector<char> within_band(const std::vector<Vec3d>& pts, const Vec3d& c, double r, std::size_t& count) {
+  std::vector<char> in(pts.size(), 0);
+  count = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    if (std::abs((pts[i] - c).norm() - r) < kFitBand * r) {
+      in[i] = 1;
+      ++count;
+    }
+  return in;
+}
+
+Consensus consensus(const std::vector<Vec3d>& pts, const std::vector<std::size_t>& seeds, double lo, double hi) {
+  Consensus best;
+  const Vec3d origin = [&] {
+    Vec3d m = Vec3d::Zero();
+    for (const Vec3d& p : pts) m += p;
+    return Vec3d(m / static_cast<double>(pts.size()));
+  }();
+  for (std::size_t seed : seeds) {
+    std::vector<char> patch(pts.size(), 0);
+    for (std::size_t i = 0; i < pts.size(); ++i) patch[i] = (pts[i] - pts[seed]).norm() < hi;
+    Sphere3 s = lsq_sphere(pts, patch, origin);
+    if (!s.ok) continue;
+    Consensus c;
+    c.s = s;
+    c.s.r = std::clamp(s.r, lo, hi);
+    if (c.s.r != s.r) c.s.c = centre_at_radius(pts, patch, s.c, c.s.r);
+    for (int it = 0; it < 20; ++it) {
+      std::size_t count = 0;
+      std::vector<char> in = within_band(pts, c.s.c, c.s.r, count);
+      if (in == c.in) break;
+      c.in = std::move(in);
+      c.count = count;
+      if (count < 4) break;
+      const Sphere3 next = lsq_sphere(pts, c.in, origin);
+      if (!next.ok) break;
+      c.at_bound = next.r > hi || next.r < lo;
+      c.s = next;
+      c.s.r = std::clamp(next.r, lo, hi);
+      if (c.s.r != next.r) c.s.c = centre_at_radius(pts, c.in, c.s.c, c.s.r);
+    }
+    if (c.count >= 4 && c.count > best.count) best = std::move(c);
+  }
+  return best;
+}
+
+// The consensus sphere refitted on its core: the roots within 3 robust standard
+// deviations (1.4826 times the median absolute residual) of it, until they no longer
+// change, its radius held in [lo, hi]. The band of a consensus widens with its radius, so
+// roots at its edge (where a neck leaves the scalp) pull the sphere towards them and are
+// joined by more; the core's width comes from the residuals of the roots themselves.
+void polish(const std::vector<Vec3d>& pts, Consensus& c, double lo, double hi) {
+  const Vec3d origin = c.s.c;
+  std::vector<char> core;
+  std::vector<double> d;
+  for (int it = 0; it < 20; ++it) {
+    d.clear();
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (c.in[i]) d.push_back(std::abs((pts[i] - c.s.c).norm() - c.s.r));
+    const double sigma = 1.4826 * median(d);
+    std::vector<char> next(pts.size(), 0);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (c.in[i] && std::abs((pts[i] - c.s.c).norm() - c.s.r) <= 3.0 * sigma) {
+        next[i] = 1;
+        ++n;
+      }
+    if (next == core || n < 4) break;
+    core = std::move(next);
+    const Sphere3 s = lsq_sphere(pts, core, origin);
+    if (!s.ok) break;
+    c.at_bound = s.r > hi || s.r < lo;
+    c.s = s;
+    c.s.r = std::clamp(s.r, lo, hi);
+    if (c.s.r != s.r) c.s.c = centre_at_radius(pts, core, c.s.c, c.s.r);
+    c.in = within_band(pts, c.s.c, c.s.r, c.count);
+  }
+}
+
+// The consensus's seed roots.
+constexpr std::size_t kFitSeeds = 32;
+
+// `k` roots spread over the groom: root 0, then each the farthest from those taken.
+std::vector<std::size_t> spread_seeds(const std::vector<Vec3d>& pts, std::size_t k) {
+  std::vector<std::size_t> seeds;
+  if (pts.empty()) return seeds;
+  std::vector<double> d(pts.size(), std::numeric_limits<double>::infinity());
+  std::size_t next = 0;
+  for (std::size_t taken = 0; taken < std::min(k, pts.size()); ++taken) {
+    seeds.push_back(next);
+    std::size_t far = next;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      d[i] = std::min(d[i], (pts[i] - pts[next]).norm());
+      if (d[i] > d[far]) far = i;
+    }
+    next = far;
+  }
+  return seeds;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
@@ -99,16 +253,53 @@ std::string edge_example(std::size_t s, std::size_t edge, double length) {
 
 }  // namespace
 
-HeadFit fit_head(const Groom& g, std::optional<double> above) {
+HeadFit fit_head(const Groom& g, std::optional<double> above, std::vector<float> metres_per_unit) {
   HeadFit fit;
   const std::size_t n = g.strand_count();
+  fit.roots = n;
   std::vector<Vec3d> roots(n);
+  for (std::size_t s = 0; s < n; ++s) roots[s] = root_of(g, s);
+
+  if (!above && n >= 4) {
+    if (metres_per_unit.empty()) metres_per_unit = unit_cues(g);
+    const std::vector<std::size_t> seeds = spread_seeds(roots, kFitSeeds);
+    const auto scalp = [&](const Consensus& c) {
+      if (c.count < 4 || static_cast<double>(c.count) < kScalpShare * static_cast<double>(n)) return false;
+      const auto [rms, cap] = residual_and_cap(roots, c.in, c.s.c, c.s.r);
+      return rms <= kScalpResidual * c.s.r && cap >= kScalpCap;
+    };
+    std::optional<Consensus> head;
+    for (const float mpu : metres_per_unit) {
+      Consensus c = consensus(roots, seeds, kHeadRadiusMin / mpu, kHeadRadiusMax / mpu);
+      if (!c.at_bound && c.count >= 4) polish(roots, c, kHeadRadiusMin / mpu, kHeadRadiusMax / mpu);
+      if (c.at_bound || !scalp(c)) {
+        c = consensus(roots, seeds, kHeadPriorMin / mpu, kHeadPriorMax / mpu);
+        if (c.count >= 4) polish(roots, c, kHeadPriorMin / mpu, kHeadPriorMax / mpu);
+      }
+      if (scalp(c) && (!head || c.count > head->count)) head = std::move(c);
+    }
+    if (head) {
+      fit.sphere = fit.scalp = true;
+      fit.method = "consensus";
+      fit.center = head->s.c.cast<float>();
+      fit.radius = static_cast<float>(head->s.r);
+      std::tie(fit.rms_residual, fit.cap) = residual_and_cap(roots, head->in, head->s.c, head->s.r);
+      for (std::size_t s = 0; s < n; ++s)
+        if (!head->in[s]) fit.rejected.push_back(static_cast<std::uint32_t>(s));
+      return fit;
+    }
+  }
+
+  // No scalp, or the roots above a height: the least-squares sphere of those roots.
+  fit.method = above ? "above" : "all roots";
   std::vector<char> use(n, 0);
   Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::max()), hi = -lo, mean = Vec3d::Zero();
   std::size_t used = 0;
   for (std::size_t s = 0; s < n; ++s) {
-    roots[s] = root_of(g, s);
-    if (above && !(roots[s].y() > *above)) continue;
+    if (above && !(roots[s].y() > *above)) {
+      fit.rejected.push_back(static_cast<std::uint32_t>(s));
+      continue;
+    }
     use[s] = 1;
     ++used;
     lo = lo.cwiseMin(roots[s]);
@@ -128,23 +319,13 @@ HeadFit fit_head(const Groom& g, std::optional<double> above) {
 
   const Sphere3 s = lsq_sphere(roots, use, mean);
   if (s.ok) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < n; ++i)
-      if (use[i]) {
-        const double d = (roots[i] - s.c).norm() - s.r;
-        sum += d * d;
-      }
-    fit.rms_residual = std::sqrt(sum / static_cast<double>(used));
+    std::tie(fit.rms_residual, fit.cap) = residual_and_cap(roots, use, s.c, s.r);
     if (fit.rms_residual > kSphereResidual * s.r)
       fit.note = "the roots are " + text(fit.rms_residual / s.r) + " of its radius off the best sphere";
     else if (s.r > kSphereSpread * spread)
       fit.note = "the roots are nearly flat (the best sphere is " + text(s.r / spread) + " times their spread)";
     else fit.sphere = true;
     if (fit.sphere) {
-      Vec3d dir = Vec3d::Zero();
-      for (std::size_t i = 0; i < n; ++i)
-        if (use[i] && (roots[i] - s.c).norm() > 0.0) dir += (roots[i] - s.c).normalized();
-      fit.cap = (dir / static_cast<double>(used)).norm();
       if (fit.rms_residual > kScalpResidual * s.r)
         fit.note = "not a scalp, so not used for the unit: the roots are " + text(fit.rms_residual / s.r) +
                    " of its radius off it (a scalp, above " + text(kScalpResidual) + ")";
@@ -227,9 +408,8 @@ struct Cue {
   std::vector<std::string> admits;
 };
 
-}  // namespace
-
-UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source) {
+// The cues of a groom's size other than its head's, each with no unit admitted yet.
+std::vector<Cue> size_cues(const Groom& g) {
   std::vector<Vec3d> roots(g.strand_count());
   Vec3d a = Vec3d::Constant(std::numeric_limits<double>::max()), b = -a;
   std::vector<double> lengths(g.strand_count()), e;
@@ -241,11 +421,13 @@ UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& sour
     for (double l : e) lengths[s] += l;
   }
   const double span = g.strand_count() ? (b - a).norm() : 0.0;
-  std::vector<Cue> cues;
-  if (fit.scalp) cues.push_back({"head radius", fit.radius, kHeadRadiusMin, kHeadRadiusMax, {}});
-  cues.push_back({"median strand", median(lengths), kStrandLengthMin, kStrandLengthMax, {}});
-  cues.push_back({"roots' span", span, kRootSpanMin, kRootSpanMax, {}});
-  cues.push_back({"root spacing", median_root_spacing(roots, span), kRootSpacingMin, kRootSpacingMax, {}});
+  return {{"median strand", median(lengths), kStrandLengthMin, kStrandLengthMax, {}},
+          {"roots' span", span, kRootSpanMin, kRootSpanMax, {}},
+          {"root spacing", median_root_spacing(roots, span), kRootSpacingMin, kRootSpacingMax, {}}};
+}
+
+// The units every cue admits, each cue's `admits` filled in.
+std::vector<std::string> admitted_units(std::vector<Cue>& cues) {
   std::vector<std::string> fits;
   for (const char* unit : {"m", "cm", "mm"}) {
     bool all = true;
@@ -257,6 +439,23 @@ UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& sour
     }
     if (all) fits.emplace_back(unit);
   }
+  return fits;
+}
+
+}  // namespace
+
+std::vector<float> unit_cues(const Groom& g) {
+  std::vector<Cue> cues = size_cues(g);
+  std::vector<float> out;
+  for (const std::string& unit : admitted_units(cues)) out.push_back(metres_per_unit(unit));
+  return out;
+}
+
+UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source) {
+  std::vector<Cue> cues;
+  if (fit.scalp) cues.push_back({"head radius", fit.radius, kHeadRadiusMin, kHeadRadiusMax, {}});
+  for (Cue& c : size_cues(g)) cues.push_back(std::move(c));
+  const std::vector<std::string> fits = admitted_units(cues);
   std::string sizes;
   for (const Cue& c : cues) {
     std::string admits;
@@ -375,7 +574,9 @@ std::vector<Repair> repair_groom(Groom& g, DegeneratePolicy policy, const std::s
     edge_lengths(g, s, e);
     for (double l : e) lengths[s] += l;
   }
-  const double short_limit = kShortStrand * median(lengths);
+  const double median_length = median(lengths);
+  const double short_limit =
+      std::max(kShortStrand * median_length, std::min(kStrandLengthMin, kShortFineStrand * median_length));
   Repair shorts{"short_strands", 0, 0, "every vertex pinned (moves rigidly with the head)", ""};
   for (std::size_t s = 0; s < g.strand_count(); ++s) {
     if (lengths[s] >= short_limit) continue;
@@ -384,9 +585,10 @@ std::vector<Repair> repair_groom(Groom& g, DegeneratePolicy policy, const std::s
     for (std::uint32_t i = b; i < b + n; ++i) free = free || g.positions[i].w() != 0.0f;
     if (!free) continue;  // already rigid
     if (policy == DegeneratePolicy::Refuse)
-      fail("strand " + std::to_string(s), "is " + text(lengths[s]) + " m long, under " + text(kShortStrand) +
-                                              " of the median strand (" + text(median(lengths)) +
-                                              " m; \"degenerate\": \"repair\" pins it)");
+      fail("strand " + std::to_string(s),
+           "is " + text(lengths[s]) + " m long, under " + text(short_limit) + " m (" + text(kShortStrand) +
+               " of the median strand, " + text(median_length) + " m, or under " + text(kStrandLengthMin) +
+               " m and " + text(kShortFineStrand) + " of it; \"degenerate\": \"repair\" pins it)");
     if (shorts.example.empty()) shorts.example = "strand " + std::to_string(s) + " (" + text(lengths[s]) + " m)";
     for (std::uint32_t i = b; i < b + n; ++i) g.positions[i].w() = 0.0f;
     ++shorts.strands;

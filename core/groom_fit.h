@@ -13,9 +13,9 @@
 
 namespace hairbench {
 
-// The sphere through a groom's roots (vertex 0 of every strand), or of the roots higher
-// than `above` (y, the groom's units) when given: a groom whose roots run past the scalp
-// (the Ratboy mohawk's run down the neck) is fitted on its crown.
+// The head sphere through a groom's roots (vertex 0 of every strand), fitted robustly
+// (fit_head below), or through the roots higher than `above` (y, the groom's units) when
+// given, which overrides the robust fit.
 struct HeadFit {
   Vec3f center = Vec3f::Zero();
   float radius = 0.0f;
@@ -26,13 +26,19 @@ struct HeadFit {
   // (never 0), and `note` says why. A sphere is the pivot and the collider.
   bool sphere = false;
   // Whether that sphere is a scalp, and so its radius evidence of the unit (guess_unit):
-  // the residual is at most kScalpResidual of the radius and the roots cover a cap of it
-  // (`cap` at least kScalpCap). A sphere that is not a scalp (TestHair1's roots all round
-  // a 64-unit ball, 0.15 of its radius off it) still gives the pivot; `note` says why it
-  // was not used for the unit.
+  // the residual of the roots it was fitted on is at most kScalpResidual of the radius
+  // and they cover a cap of it (`cap` at least kScalpCap). A sphere that is not a scalp
+  // (TestHair1's roots all round a 64-unit ball, 0.15 of its radius off it) still gives
+  // the pivot; `note` says why it was not used for the unit.
   bool scalp = false;
-  double rms_residual = 0.0;  // RMS of |p - c| - r over the roots, in the groom's units
+  double rms_residual = 0.0;  // RMS of |p - c| - r over the roots fitted, in the groom's units
   double cap = 0.0;           // |mean of (p - c) / |p - c||: 1 for one point, 0 all round
+  // Which roots the sphere went through: "consensus" (the scalp's, the others rejected),
+  // "all roots" (no scalp found: the least-squares sphere of every root) or "above" (the
+  // roots above the given height).
+  std::string method;
+  std::size_t roots = 0;                // strands
+  std::vector<std::uint32_t> rejected;  // strands whose roots the fit left out, ascending
   std::string note;
 };
 
@@ -49,9 +55,37 @@ inline constexpr double kScalpResidual = 0.125;
 // 0 (TestHair1: 0.04).
 inline constexpr double kScalpCap = 0.15;
 
-// Least squares: |p|^2 = 2 c.p + (r^2 - |c|^2) is linear in (c, r^2 - |c|^2), solved in
-// double precision over the roots, centred on their mean for conditioning.
-HeadFit fit_head(const Groom& g, std::optional<double> above = std::nullopt);
+// The robust fit's consensus: a root belongs to a sphere of radius r when it lies within
+// kFitBand r of it. A band of half-width 0.2 r holds a scalp's roots (their RMS residual
+// is at most kScalpResidual r; a uniform band of half-width b has RMS b/sqrt(3) = 0.115 r)
+// and leaves out a neck, a beard or a ponytail's tie, which run off the sphere.
+inline constexpr double kFitBand = 0.2;
+// The scalp holds at least this share of the roots: the Ratboy mohawk's crown holds 0.43
+// of its roots (the rest run down its neck and back); a patch of TestHair1's ball that a
+// head-sized sphere fits holds 0.04 of them.
+inline constexpr double kScalpShare = 0.25;
+// The prior: a head's radius, for people and for most animals a groom is made for.
+inline constexpr double kHeadPriorMin = 0.08, kHeadPriorMax = 0.15;
+
+// The head sphere, deterministic (docs/groom-import.md, "The fitted head"). Without
+// `above`, for each unit in `metres_per_unit` (empty: the units the groom's strand
+// lengths, span and root spacing admit, unit_cues):
+//  1. the consensus sphere with a radius in the accepted head range [kHeadRadiusMin,
+//     kHeadRadiusMax): from each of 32 seed roots spread over the groom (farthest-point
+//     order), the least-squares sphere of the roots within the range's largest radius
+//     of it, then refitted on the roots within kFitBand of it until they no longer change,
+//     its radius held in the range; the seed whose sphere holds the most roots wins, and
+//     is refitted on its core (the roots within 3 robust standard deviations of it). It is
+//     the head when its radius settles inside the range (a sphere pressed against the top
+//     of the range is a surface larger than any head: a neck and back with the crown) and
+//     its roots are a scalp holding kScalpShare of them;
+//  2. otherwise the same consensus with the radius held in the prior [kHeadPriorMin,
+//     kHeadPriorMax], the head when its roots are a scalp holding kScalpShare of them.
+// The unit whose head holds the most roots wins. With no head, the least-squares sphere
+// of every root, classified as above. Least squares: |p|^2 = 2 c.p + (r^2 - |c|^2) is
+// linear in (c, r^2 - |c|^2), solved in double precision, centred on the roots' mean.
+HeadFit fit_head(const Groom& g, std::optional<double> above = std::nullopt,
+                 std::vector<float> metres_per_unit = {});
 
 // The unit of a groom from its size, in metres per file unit. Each cue below admits the
 // units (m, cm, mm) under which its size is that of real hair on a real head, and the
@@ -69,6 +103,8 @@ struct UnitGuess {
   std::string why;  // the sizes it was read from, for the terminal and the report
 };
 UnitGuess guess_unit(const Groom& g, const HeadFit& fit, const std::string& source);
+// The units (metres per file unit) every cue but the head radius admits.
+std::vector<float> unit_cues(const Groom& g);
 // Head radii in metres: a child's head to a helmet (and the ponytail asset's outsized
 // 32 cm head).
 inline constexpr double kHeadRadiusMin = 0.04, kHeadRadiusMax = 0.4;
@@ -104,6 +140,14 @@ inline constexpr double kShortEdge = 0.25;
 // A strand shorter than this fraction of the groom's median strand length is far
 // shorter than the rest: its edges are too short for a solver tuned to the groom.
 inline constexpr double kShortStrand = 0.1;
+// A strand under kStrandLengthMin (2 cm: it sags by under 1% of its length, and hardly
+// moves) and under this fraction of the median strand is pinned too. Its edges are under
+// a quarter of the groom's (kShortEdge's ratio, strand for strand), and position-based
+// solvers tuned to the groom leave its edges stretched by many of their own lengths: the
+// Ratboy mohawk's 0.80 and 0.86 cm strands (of 32 vertices; median 8 cm) by 3.4 under the
+// wisp model and 10-13 under Han & Harada's methods on `shake`. The mohawk's built-in
+// scenario pins the same 115 strands (rigid_strands_below 0.02).
+inline constexpr double kShortFineStrand = 0.25;
 
 enum class DegeneratePolicy { Repair, Refuse };
 

@@ -711,7 +711,7 @@ void add_merge_options(CLI::App& sub, MergeArgs& a) {
 void add_groom_fit_options(CLI::App& sub, std::string& unit, std::optional<double>& fit_above) {
   sub.add_option("--fit-above", fit_above,
                  "fit the head sphere through the roots higher than Y (file\n"
-                 "units) only, for roots that run past the scalp")
+                 "units) only, instead of finding the scalp's roots")
       ->type_name("Y");
   sub.add_option("--unit", unit, "the groom's unit: cm, mm, m, or auto (guessed from its\nsize)")
       ->type_name("cm|mm|m|auto")

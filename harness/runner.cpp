@@ -187,6 +187,19 @@ nlohmann::json substeps_json(const SubstepsChoice& c) {
 
 namespace {
 
+// Ascending strand indices as inclusive runs [first, last]: the fit's rejected roots are
+// mostly whole runs of an asset's strands (a neck, a ponytail's tie).
+nlohmann::json strand_ranges(const std::vector<std::uint32_t>& strands) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t i = 0; i < strands.size();) {
+    std::size_t j = i;
+    while (j + 1 < strands.size() && strands[j + 1] == strands[j] + 1) ++j;
+    out.push_back({strands[i], strands[j]});
+    i = j + 1;
+  }
+  return out;
+}
+
 nlohmann::json params_json(const ParamSet& p, const Groom& g) {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& [name, v] : p.base()) j[name] = v;
@@ -788,6 +801,10 @@ void LockstepRun::record_scenario(int frames) const {
                           {"center_m", {im.fit.center.x(), im.fit.center.y(), im.fit.center.z()}},
                           {"radius_m", im.fit.radius},
                           {"rms_residual_m", im.fit.rms_residual},
+                          {"method", im.fit.method},
+                          {"roots", im.fit.roots},
+                          {"roots_rejected", im.fit.rejected.size()},
+                          {"rejected_strands", strand_ranges(im.fit.rejected)},
                           {"note", im.fit.note}};
   }
   out.phases.clear();

@@ -89,23 +89,33 @@ std::string import_summary(const Scenario& sc) {
   os << "groom " << im.file.string() << ": " << sc.groom.strand_count() - follow << " strands";
   if (follow) os << " (+" << follow << " follow hairs)";
   os << ", " << sc.groom.vertex_count() << " vertices\n";
-  os << "  unit " << im.unit << (im.unit_from == "given" ? " (given)" : " (guessed: " + im.unit_from + ")") << "\n";
-  os << "  pivot [" << text(im.pivot.x()) << ", " << text(im.pivot.y()) << ", " << text(im.pivot.z())
-     << "] file units (" << im.pivot_from;
+  // The unit, the head and the repairs on one line: a wrong fit shows before any metric.
+  os << "  unit " << im.unit << (im.unit_from == "given" ? " (given)" : " (guessed: " + im.unit_from + ")");
   if (im.fitted) {
-    if (im.fit.sphere)
-      os << ": sphere through the roots, RMS residual " << text(im.fit.rms_residual * 1e3, "%.3g") << " mm"
-         << (im.fit.scalp ? "" : "; " + im.fit.note);
-    else
-      os << ": no sphere, " << im.fit.note;
+    const HeadFit& f = im.fit;
+    const float mpu = metres_per_unit(im.unit);
+    const Vec3f c = f.center / mpu;  // fitted in metres, before the pivot moved the groom
+    const std::size_t used = f.roots - f.rejected.size();
+    os << "; head ";
+    if (!f.sphere) {
+      os << "not fitted: " << f.note;
+    } else {
+      os << "fit on " << used << " of " << f.roots << " roots";
+      if (f.method == "consensus") os << " (" << f.rejected.size() << " rejected: off the scalp's sphere)";
+      else if (f.method == "above") os << " (" << f.rejected.size() << " rejected: at or below --fit-above)";
+      os << ": centre [" << text(c.x()) << ", " << text(c.y()) << ", " << text(c.z()) << "] file units, radius " << text(f.radius, "%.4f") << " m, RMS residual "
+         << text(f.rms_residual * 1e3, "%.3g") << " mm" << (f.scalp ? "" : "; " + f.note);
+    }
   }
-  os << ")\n";
-  os << "  head radius " << text(sc.head_radius, "%.4f") << " m" << (im.head_radius_fit ? " (fit)" : "") << "; colliders:";
+  os << "; " << repairs_text(im.repairs) << "\n";
+  os << "  pivot [" << text(im.pivot.x()) << ", " << text(im.pivot.y()) << ", " << text(im.pivot.z())
+     << "] file units (" << im.pivot_from << ")";
+  os << "; head radius " << text(sc.head_radius, "%.4f") << " m" << (im.head_radius_fit ? " (fit)" : "") << "; colliders:";
   for (const Sphere& s : sc.colliders)
     os << " r " << text(s.radius, "%.4f") << " m at [" << text(s.center.x(), "%.3f") << ", "
        << text(s.center.y(), "%.3f") << ", " << text(s.center.z(), "%.3f") << "]";
   if (sc.colliders.empty()) os << " none";
-  os << "\n  " << repairs_text(im.repairs) << "\n";
+  os << "\n";
   return os.str();
 }
 

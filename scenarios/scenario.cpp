@@ -499,7 +499,7 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius, bool head_rad
   if (pivot_fit || head_radius_fit) {
     const auto start = std::chrono::steady_clock::now();
     info.fit = fit_head(asset.follow.empty() ? asset.groom : guide_groom(asset.groom, asset.follow),
-                        fit_above ? std::optional<double>(*fit_above * mpu) : std::nullopt);
+                        fit_above ? std::optional<double>(*fit_above * mpu) : std::nullopt, {1.0f});
     info.fitted = true;
     info.seconds_fit += seconds_since(start);
   }
@@ -523,6 +523,13 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius, bool head_rad
   translate(asset.groom, -pivot);
   for (Sphere& s : asset.colliders) s.center -= pivot;
   if (head_radius_fit) {
+    // A scalp-shaped sphere no head has: the unit is wrong, or the fit found another surface.
+    if (info.fit.scalp && !(info.fit.radius >= kHeadRadiusMin && info.fit.radius < kHeadRadiusMax))
+      r.fail("head.radius", "the roots fit a scalp-shaped sphere of radius " + num_text(info.fit.radius) +
+                                " m, outside a head's [" + num_text(kHeadRadiusMin) + ", " + num_text(kHeadRadiusMax) +
+                                ") m, with the unit " + info.unit + " (" + (info.unit_from == "given" ? "given" : "guessed") +
+                                "); give the unit (--unit, \"unit\"), fit on the scalp's roots (--fit-above, "
+                                "\"fit_above\") or give head.radius and the pivot");
     if (!(info.fit.radius > 0.0f && info.fit.radius <= 1.0f))
       r.fail("head.radius", "the fitted head radius is " + num_text(info.fit.radius) +
                                 " m, outside (0, 1] (check the groom's unit)");
@@ -597,8 +604,9 @@ std::vector<Sphere> read_groom(const Obj& top, Scenario& sc, bool head_radius_fi
   return {};
 }
 
-// "radius": "fit" is the head radius, shrunk until no free rest vertex of the groom lies
-// inside (the sphere the fitted head stands for, without flinging hair out at frame 0).
+// "radius": "fit" is the head radius, shrunk until no rest vertex of the groom, pinned or
+// free, lies inside (the sphere the fitted head stands for, without flinging hair out or
+// stretching a root's edge at frame 0; tfx::fit_spheres_to_rest_hair).
 Sphere read_collider(const Reader& r, const json& j, const std::string& path, Scenario& sc) {
   const Obj o(r, j, path, {"type", "center", "radius", "attached"});
   o.one_of("type", {"sphere"});
@@ -608,9 +616,9 @@ Sphere read_collider(const Reader& r, const json& j, const std::string& path, Sc
     o.one_of("radius", {"fit"});
     std::vector<Sphere> one{{s.center, sc.head_radius, true}};
     const auto start = std::chrono::steady_clock::now();
-    tfx::fit_spheres_to_rest_hair(one, sc.groom);
+    tfx::fit_spheres_to_rest_hair(one, sc.groom, true);
     if (sc.import) sc.import->seconds_fit += seconds_since(start);
-    if (!(one[0].radius > 0.0f)) r.fail(o.key("radius"), "a free rest vertex lies at the centre: no sphere fits");
+    if (!(one[0].radius > 0.0f)) r.fail(o.key("radius"), "a rest vertex lies at the centre: no sphere fits");
     s.radius = one[0].radius;
   } else {
     const double radius = o.number("radius");

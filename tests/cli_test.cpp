@@ -384,14 +384,15 @@ TEST(Cli, GroomErrorsAreOneLine) {
       {"compare --groom " + kMohawkTfx + " --unit furlong" + out, "arguments: --unit: 'furlong' is not cm, mm, m or auto"},
       {"compare --groom " + kMohawkTfx + " --motion moonwalk" + out, "--motion: moonwalk: not a built-in scenario"},
       // All the mohawk's roots (down the neck) fit a head in mm; its strands are hair in cm.
-      {"compare --groom " + kMohawkTfx + out, kMohawkTfx + ": unit: cannot tell the unit: no unit fits every cue"},
+      {"compare --groom " + kMohawkTfx + " --fit-above -1000" + out,
+       kMohawkTfx + ": unit: cannot tell the unit: no unit fits every cue"},
       {"compare --groom " + std::string(HAIRBENCH_TEST_DATA_DIR) + "/reports/tiny_shake.json" + out,
        "expected a TressFX .tfx or .tfxproj file"},
       {"scenario new --groom /no/such/groom.tfx --out /tmp/hairbench-cli-groom.json",
        "--groom: /no/such/groom.tfx: no such file"},
       {"scenario new --groom " + kMohawkTfx + " --out /tmp/hairbench-cli-groom.txt",
        "--out: /tmp/hairbench-cli-groom.txt: expected a .json file name"},
-      {"scenario new --groom " + kMohawkTfx + " --out /tmp/hairbench-cli-groom.json",
+      {"scenario new --groom " + kMohawkTfx + " --fit-above -1000 --out /tmp/hairbench-cli-groom.json",
        "unit: cannot tell the unit"}};
   std::filesystem::remove("/tmp/hairbench-cli-groom.json");
   for (const auto& [args, expected] : cases) {
@@ -402,7 +403,7 @@ TEST(Cli, GroomErrorsAreOneLine) {
     EXPECT_EQ(r.out.rfind("hairbench: ", 0), 0u) << r.out;
   }
   // A refused unit says how to give it.
-  EXPECT_NE(run_cli("compare --groom " + kMohawkTfx + out).out.find("--unit"), std::string::npos);
+  EXPECT_NE(run_cli("compare --groom " + kMohawkTfx + " --fit-above -1000" + out).out.find("--unit"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists("/tmp/hairbench-cli-groom.json"));
 }
 

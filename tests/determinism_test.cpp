@@ -29,7 +29,7 @@ constexpr std::size_t kKeepEvery = 10;
 const std::pair<const char*, const char*> kExpectedHash[] = {
     {"han_m1_ref", "503d58a976aca2ce"},        {"han_m2_ref", "b51af50c942088ce"},
     {"han_m3_ref", "55bd3c29c969089b"},        {"halen_spring_ref", "3ef9a60168ce0c50"},
-    {"halen_cascade_ref", "b037d2d0c39d53a6"}, {"halen_forest_ref", "8074c90fe3db4758"},
+    {"halen_cascade_ref", "3f9b6997419fe8fa"}, {"halen_forest_ref", "8074c90fe3db4758"},
     {"plante_wisp_ref", "1f29d7fc5af2b294"},
 };
 

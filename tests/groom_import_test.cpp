@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <tuple>
 
 namespace fs = std::filesystem;
 using namespace hairbench;
@@ -60,6 +61,14 @@ TEST(HeadFit, AgreesWithTheBuiltInScenariosHandFits) {
   ASSERT_TRUE(ponytail.sphere) << ponytail.note;
   expect_near(ponytail.center, Vec3f(-0.095f, 92.0f, 9.899f), 26.5f * 0.25f);
   EXPECT_NEAR(ponytail.radius, 26.5f, 26.5f * 0.25f);
+  // The consensus leaves out the tie: the tail section's 474 guides, rooted 45 cm behind
+  // the head's centre on a ring of a few centimetres, are most of what it rejects.
+  EXPECT_EQ(ponytail.method, "consensus");
+  EXPECT_GT(ponytail.rejected.size(), 400u);
+  EXPECT_LT(ponytail.rejected.size(), ponytail.roots / 4);
+  // TestHair1's roots lie all round a ball: no scalp; the sphere through all of them.
+  EXPECT_EQ(testhair.method, "all roots");
+  EXPECT_TRUE(testhair.rejected.empty());
 }
 
 TEST(HeadFit, RootsOnALineFallBackWithANote) {
@@ -104,15 +113,85 @@ TEST(HeadFit, ShippedAssetsGiveTheirBuiltInUnitOrARefusal) {
   EXPECT_FALSE(tfit.scalp);
   EXPECT_NE(tfit.note.find("not a scalp"), std::string::npos) << tfit.note;
   EXPECT_EQ(guess_unit(testhair, tfit, "testhair").unit, "cm");
-  // All the mohawk's roots, down the neck, fit a 53-unit sphere: a head in mm, but its
-  // 8-unit median strand is hair only in cm. The cues disagree: refused.
+  // The mohawk's consensus is its crown, a 15-unit head: cm.
   const Groom mohawk = tfx::read_tfx_strands(kMohawk);
-  const std::string why = error_of([&] { guess_unit(mohawk, fit_head(mohawk), "mohawk"); });
+  EXPECT_EQ(guess_unit(mohawk, fit_head(mohawk), "mohawk").unit, "cm");
+  // All its roots, down the neck, fit a 53-unit sphere: a head in mm, but its 8-unit
+  // median strand is hair only in cm. The cues disagree: refused.
+  const std::string why = error_of([&] { guess_unit(mohawk, fit_head(mohawk, -1e9), "mohawk"); });
   EXPECT_EQ(why.rfind("mohawk: unit: cannot tell the unit: no unit fits every cue [file units: head radius 52.86", 0),
             0u)
       << why;
   EXPECT_NE(why.find("--unit"), std::string::npos) << why;
   EXPECT_NE(why.find("--fit-above"), std::string::npos) << why;
+}
+
+// The robust fit: the mohawk's roots run from its crown down its neck and back, and all of
+// them fit a 53 cm sphere (RMS residual 0.05 of it, a cap: shaped like a scalp). The
+// consensus finds the crown: a sphere of a head's size, 8-15 cm, near the built-in
+// scenario's hand fit, through under half the roots, in cm and in metres alike, with the
+// unit given or not. Its crown alone (the roots above 75 cm) fits the same head.
+TEST(HeadFit, ConsensusFindsTheMohawksCrownNotItsNeck) {
+  Groom cm = tfx::read_tfx_strands(kMohawk);
+  Groom m = cm;
+  for (Vec4f& p : m.positions) p.head<3>() *= 0.01f;
+  for (const auto& [groom, mpu, units] :
+       {std::tuple{&cm, 0.01f, std::vector<float>{}}, std::tuple{&cm, 0.01f, std::vector<float>{0.01f}},
+        std::tuple{&m, 1.0f, std::vector<float>{}}, std::tuple{&m, 1.0f, std::vector<float>{1.0f}}}) {
+    const HeadFit fit = fit_head(*groom, std::nullopt, units);
+    SCOPED_TRACE("metres per unit " + std::to_string(mpu) + (units.empty() ? ", unit guessed" : ", unit given"));
+    EXPECT_EQ(fit.method, "consensus");
+    EXPECT_TRUE(fit.scalp) << fit.note;
+    EXPECT_GE(fit.radius * mpu, kHeadPriorMin);
+    EXPECT_LE(fit.radius * mpu, kHeadPriorMax * (1 + 1e-6));
+    expect_near(fit.center * (mpu / 0.01f), Vec3f(-0.15f, 74.52f, 13.0f), 3.0f);
+    EXPECT_EQ(fit.roots, 2226u);
+    EXPECT_GT(fit.rejected.size(), 1000u);  // the neck and back
+    EXPECT_LT(fit.rejected.size(), 1500u);
+    // The rejected roots are the low ones: none of the crown's above 80 cm.
+    for (std::uint32_t s : fit.rejected) EXPECT_LT(groom->positions[groom->strand_begin(s)].y() / (mpu / 0.01f), 80.0f);
+  }
+  std::vector<std::uint32_t> crown;
+  for (std::uint32_t s = 0; s < cm.strand_count(); ++s)
+    if (cm.positions[cm.strand_begin(s)].y() > 75.0f) crown.push_back(s);
+  const HeadFit top = fit_head(select_strands(cm, crown));
+  EXPECT_EQ(top.method, "consensus");
+  EXPECT_NEAR(top.radius, 15.15f, 1.0f);
+  expect_near(top.center, Vec3f(-0.15f, 74.52f, 13.0f), 1.0f);
+  EXPECT_LT(top.rejected.size(), crown.size() / 10);
+}
+
+// Roots on a 10 cm scalp cap (from 0.3 of the radius below the centre up) and down a
+// neck under it (a column of 6 cm radius, its axis 2 cm behind the centre, from 9 to 30 cm
+// below it): the fit is the scalp, and what it rejects is the neck. The neck's top few
+// centimetres lie within the band of the scalp's sphere and join the consensus (nape
+// hair), which pulls the sphere down and out a little: radius within 10%, centre within
+// 1.5 cm; every root it rejects is the neck's, and most of the neck is rejected.
+TEST(HeadFit, ConsensusRejectsANeckColumnUnderAScalp) {
+  Groom g;
+  const int scalp = 600, neck = 600;
+  for (int i = 0; i < scalp + neck; ++i) {
+    // Even spreads by the golden angle: deterministic, no generator.
+    const bool on_scalp = i < scalp;
+    const double u = ((on_scalp ? i : i - scalp) + 0.5) / (on_scalp ? scalp : neck), phi = 2.399963 * i;
+    Vec3f root, out;
+    if (on_scalp) {
+      const double y = -0.3 + 1.3 * u, r = std::sqrt(1.0 - y * y);
+      out = Vec3f(float(r * std::cos(phi)), float(y), float(r * std::sin(phi)));
+      root = 0.1f * out;
+    } else {
+      out = Vec3f(float(std::cos(phi)), 0.0f, float(std::sin(phi)));
+      root = 0.06f * out + Vec3f(0.0f, float(-0.09 - 0.21 * u), -0.02f);
+    }
+    const std::vector<Vec3f> pts{root, root + 0.05f * out, root + 0.1f * out};
+    g.add_strand(pts, 0);
+  }
+  const HeadFit fit = fit_head(g, std::nullopt, {1.0f});
+  EXPECT_EQ(fit.method, "consensus");
+  EXPECT_NEAR(fit.radius, 0.1f, 0.01f);
+  expect_near(fit.center, Vec3f::Zero(), 0.015f);
+  EXPECT_GT(fit.rejected.size(), std::size_t(0.75 * neck));
+  for (std::uint32_t s : fit.rejected) EXPECT_GE(s, std::uint32_t(scalp)) << "a scalp root rejected";
 }
 
 // The mohawk in metres with strand 100's edge 5 made zero and strand 200's edge 7 1e-7 m
@@ -250,19 +329,79 @@ TEST(GroomScenario, FitsEverythingFromTheGroomAlone) {
   EXPECT_EQ(sc.import->pivot_from, "fit");
   expect_near(sc.import->pivot, Vec3f(-0.15f, 74.52f, 13.0f), 0.01f);
   EXPECT_NEAR(sc.head_radius, 0.1515f, 1e-3f);
-  // The collider is the head sphere shrunk until no free rest vertex is inside it.
+  // The collider is the head sphere shrunk until no rest vertex, pinned or free, is
+  // inside it.
   ASSERT_EQ(sc.colliders.size(), 1u);
   EXPECT_LE(sc.colliders[0].radius, sc.head_radius);
-  // The nearest free rest vertex stays a clearance outside it, not on its surface, where
+  // The nearest rest vertex stays a clearance outside it, not on its surface, where
   // rounding would decide whether a model finds it inside.
   float nearest = std::numeric_limits<float>::infinity();
-  for (const Vec4f& p : sc.groom.positions)
-    if (p.w() != 0.0f) nearest = std::min(nearest, (p.head<3>() - sc.colliders[0].center).norm());
+  for (const Vec4f& p : sc.groom.positions) nearest = std::min(nearest, (p.head<3>() - sc.colliders[0].center).norm());
   EXPECT_EQ(sc.colliders[0].radius, nearest * (1.0f - tfx::kColliderClearance));
   EXPECT_GT(nearest - sc.colliders[0].radius, 1e-4f);
   EXPECT_EQ(error_of([] { groom_scenario_json(kMohawk, "x", "moonwalk", "auto"); }).rfind(
                 "--motion: moonwalk: not a built-in scenario (one of: ", 0),
             0u);
+}
+
+// Without --fit-above: the mohawk with its unit given, guessed, and as a metres copy with
+// "m" fits a head of 8-15 cm through its crown's roots; the import says how many roots it
+// rejected.
+TEST(GroomScenario, FitsTheMohawksHeadWithoutBeingToldWhere) {
+  Groom metres = tfx::read_tfx_strands(kMohawk);
+  for (Vec4f& p : metres.positions) p.head<3>() *= 0.01f;
+  const fs::path copy = fs::temp_directory_path() / "hairbench_mohawk_in_metres.tfx";
+  tfx::write_tfx_v4(copy, metres);
+  for (const auto& [file, unit, mpu] :
+       {std::tuple{kMohawk, "cm", 0.01f}, std::tuple{kMohawk, "auto", 0.01f}, std::tuple{copy, "m", 1.0f}}) {
+    SCOPED_TRACE(file.string() + " " + unit);
+    const nlohmann::json doc = groom_scenario_json(file, file.string(), "shake", unit);
+    const Scenario sc = load_scenario_text(doc.dump(), fs::temp_directory_path() / "mohawk_shake.json");
+    ASSERT_TRUE(sc.import);
+    EXPECT_EQ(sc.import->fit.method, "consensus");
+    EXPECT_GE(sc.head_radius, kHeadPriorMin);
+    EXPECT_LE(sc.head_radius, kHeadPriorMax * (1 + 1e-6));
+    expect_near(sc.import->pivot * (mpu / 0.01f), Vec3f(-0.15f, 74.52f, 13.0f), 3.0f);
+    EXPECT_GT(sc.import->fit.rejected.size(), 1000u);
+    const std::string summary = import_summary(sc);
+    EXPECT_NE(summary.find("head fit on " + std::to_string(2226 - sc.import->fit.rejected.size()) + " of 2226 roots (" +
+                           std::to_string(sc.import->fit.rejected.size()) + " rejected"),
+              std::string::npos)
+        << summary;
+  }
+}
+
+// A scalp-shaped sphere no head has is refused with the radius, the unit and the options:
+// the mohawk's centimetres read as metres give no head of a head's size, and its roots a
+// 53 m scalp.
+TEST(GroomScenario, RefusesAScalpNoHeadHas) {
+  const nlohmann::json doc = groom_scenario_json(kMohawk, kMohawk.string(), "shake", "m");
+  const std::string why =
+      error_of([&] { load_scenario_text(doc.dump(), fs::temp_directory_path() / "mohawk_shake.json"); });
+  EXPECT_NE(why.find("head.radius: the roots fit a scalp-shaped sphere of radius 52.8"), std::string::npos) << why;
+  EXPECT_NE(why.find("outside a head's [0.04, 0.4) m, with the unit m (given)"), std::string::npos) << why;
+  EXPECT_NE(why.find("--unit"), std::string::npos) << why;
+  EXPECT_NE(why.find("--fit-above"), std::string::npos) << why;
+}
+
+// Short strands: under 1/10 of the median pinned; under 2 cm and 1/4 of the median pinned;
+// a strand under 2 cm in a groom of short hair (median 1.5 cm) left free.
+TEST(Hygiene, ShortStrandsArePinnedByLengthAndByShareOfTheMedian) {
+  auto strand = [](float x, float length) {
+    return std::vector<Vec3f>{{x, 0, 0}, {x, length / 2, 0}, {x, length, 0}};
+  };
+  Groom g;
+  for (int i = 0; i < 9; ++i) g.add_strand(strand(0.01f * i, 0.10f), 0);
+  g.add_strand(strand(0.2f, 0.019f), 0);  // under 2 cm and under 1/4 of 10 cm
+  g.add_strand(strand(0.3f, 0.03f), 0);   // over 2 cm, over 1/10
+  repair_groom(g, DegeneratePolicy::Repair, "g");
+  EXPECT_EQ(g.positions[g.strand_begin(9) + 2].w(), 0.0f);
+  EXPECT_NE(g.positions[g.strand_begin(10) + 2].w(), 0.0f);
+  Groom fur;
+  for (int i = 0; i < 9; ++i) fur.add_strand(strand(0.01f * i, 0.015f), 0);
+  fur.add_strand(strand(0.2f, 0.012f), 0);  // under 2 cm, but 0.8 of the median
+  repair_groom(fur, DegeneratePolicy::Repair, "fur");
+  EXPECT_NE(fur.positions[fur.strand_begin(9) + 2].w(), 0.0f);
 }
 
 }  // namespace

@@ -217,12 +217,13 @@ verdict::Probe probe(const std::string& model, const Scenario& sc, const std::ve
 // as halves of torsion springs (the default) the kick stays far below growth.
 TEST(Probe, CascadeGrowsAtSixteenNodesOnlyWithFixedReferenceNodes) {
   const Scenario sc = idle_with(16);
-  const verdict::Probe fixed = probe("halen_cascade", sc, {{"halen_cascade", "reactions", 0}});
+  const verdict::Probe fixed =
+      probe("halen_cascade", sc, {{"halen_cascade", "reactions", 0}, {"halen_cascade", "nodes", 16}});
   ASSERT_TRUE(fixed.run);
   EXPECT_TRUE(fixed.grows);
   EXPECT_GT(fixed.rate, ProbeSettings::kMinGrowthRate);
   EXPECT_GT(fixed.last, ProbeSettings::kMinGrowth * ProbeSettings::kAmplitude);
-  const verdict::Probe torsion = probe("halen_cascade", sc, {});
+  const verdict::Probe torsion = probe("halen_cascade", sc, {{"halen_cascade", "nodes", 16}});
   ASSERT_TRUE(torsion.run);
   EXPECT_FALSE(torsion.grows);
   EXPECT_LT(torsion.last, 0.25 * ProbeSettings::kMinGrowth * ProbeSettings::kAmplitude);
@@ -240,7 +241,8 @@ TEST(Verdict, CascadeOnIdleRestsAndItsFixedReferenceNodesAreUnstable) {
       RunOptions opt;
       opt.models = {"halen_cascade", "han_m1"};
       opt.skip_inert = skip == 1;
-      if (fixed) opt.overrides = {{"halen_cascade", "reactions", 0}};
+      opt.overrides = {{"halen_cascade", "nodes", 16}};
+      if (fixed) opt.overrides.push_back({"halen_cascade", "reactions", 0});
       runs[fixed][skip] = run_scenario(sc, opt, pool);
     }
   for (int skip = 0; skip < 2; ++skip) {
@@ -266,7 +268,7 @@ TEST(Verdict, EveryRunCarriesItsReferencesVerdict) {
   RunOptions opt;
   opt.models = {"han_m3"};
   opt.reference = "halen_cascade";
-  opt.reference_overrides = {{"halen_cascade", "reactions", 0}};
+  opt.reference_overrides = {{"halen_cascade", "reactions", 0}, {"halen_cascade", "nodes", 16}};
   const RunRecord against_unstable = run_scenario(sc, opt, pool).front();
   EXPECT_EQ(against_unstable.reference, "halen_cascade");
   EXPECT_EQ(against_unstable.reference_status, Status::unstable);
@@ -361,7 +363,8 @@ TEST(Verdict, MethodOneFluttersOnTheFoldedPonytailGuideAsAuthoredAndRestsOnTheRe
 }
 
 // Does the hair come back (verdict::Return)? TestHair1's guides, every 8th, through their
-// built-in motion: the cascade, whose reference springs return it slowly, ends far from
+// built-in motion: the cascade made ten times softer (stiffness 600 s^-2), whose reference
+// springs then return it slowly (0.38 L-bar off, e-folding time 13 s), ends far from
 // where it rests with the head held still at the final pose, and coming back; the spring
 // model and method 1 return. Each is measured against its own twin, so their different
 // sags are not a deformation.
@@ -369,7 +372,8 @@ TEST(Verdict, HairThatDoesNotReturnIsDeformedWithItsDistanceAndRate) {
   Scenario sc = load_scenario(find_scenario("tressfx_testhair1"));
   sc.groom = every_nth_strand(sc.follow ? sc.guides : sc.groom, 8);
   sc.follow.reset();
-  const std::vector<RunRecord> runs = test::run(sc, {"han_m1", "halen_spring", "halen_cascade"});
+  const std::vector<RunRecord> runs =
+      test::run(sc, {"han_m1", "halen_spring", "halen_cascade"}, {{"halen_cascade", "stiffness", 600}});
   for (const RunRecord& r : runs) {
     SCOPED_TRACE(r.model);
     const verdict::Return& back = r.verdict.back;

@@ -33,16 +33,11 @@ struct StrandNodes {
 };
 
 // `s`: the arc length of every vertex of `rest`.
-StrandNodes strand_nodes(std::span<const Vec4f> rest, std::span<const double> s, int count, bool root_node_only) {
+StrandNodes strand_nodes(std::span<const Vec4f> rest, std::span<const double> s, int count) {
   const std::size_t n = rest.size();
-  std::size_t root_pins = 0;
-  while (root_pins < n && rest[root_pins].w() == 0.0f) ++root_pins;
   std::vector<std::uint32_t> anchors;
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool root_prefix = i > 0 && i < root_pins;
-    if (i == 0 || i + 1 == n || (rest[i].w() == 0.0f && !(root_node_only && root_prefix)))
-      anchors.push_back(static_cast<std::uint32_t>(i));
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (i == 0 || i + 1 == n || rest[i].w() == 0.0f) anchors.push_back(static_cast<std::uint32_t>(i));
 
   // Free stretches between consecutive anchors and their share of the free nodes.
   const std::size_t stretches = anchors.size() - 1;
@@ -101,7 +96,7 @@ Vec3f point_at(std::span<const Vec4f> rest, std::span<const double> s, std::uint
 
 }  // namespace
 
-NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static, bool root_node_only) {
+NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static) {
   NodeLayout out;
   out.nodes.region_names = drawn.region_names;
   out.nodes.head_radius = drawn.head_radius;
@@ -112,12 +107,13 @@ NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static, bool ro
     const std::size_t n = rest.size();
     std::vector<double> s(n, 0.0);
     for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (xyz(rest[i]) - xyz(rest[i - 1])).cast<double>().norm();
-    // Held: pinned at both ends with a free vertex between (a strand pinned whole is the
-    // groom's rigid strand already, not one the model holds).
-    const bool held = tied_static && n > 1 && rest[0].w() == 0.0f && rest[n - 1].w() == 0.0f &&
-                      std::any_of(rest.begin(), rest.end(), [](const Vec4f& v) { return v.w() != 0.0f; });
+    // Held: a pinned vertex after a free one, at the tip or in the middle (a strand pinned
+    // whole is the groom's rigid strand already, not one the model holds).
+    const auto first_free = std::find_if(rest.begin(), rest.end(), [](const Vec4f& v) { return v.w() != 0.0f; });
+    const bool held = tied_static && first_free != rest.end() &&
+                      std::any_of(first_free, rest.end(), [](const Vec4f& v) { return v.w() == 0.0f; });
     out.static_strands += held;
-    const StrandNodes sn = strand_nodes(rest, s, count, root_node_only);
+    const StrandNodes sn = strand_nodes(rest, s, count);
     const std::size_t first = out.nodes.positions.size();
     for (std::size_t j = 0; j < sn.arc.size(); ++j) {
       // A node on a vertex is that vertex, bit for bit; a node inside an edge takes the
@@ -131,19 +127,14 @@ NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static, bool ro
     out.nodes.strand_offsets.push_back(static_cast<std::uint32_t>(out.nodes.positions.size()));
     const auto nodes = std::span(out.nodes.positions).subspan(first, sn.arc.size());
 
-    // Each pinned vertex that is a node on that node, each other one on the node segment
-    // that holds its arc length.
+    // Each pinned vertex rigid with the head (it is a node, which the model moves with
+    // the head too, but the drawing does not depend on that), each other one on the node
+    // segment that holds its arc length.
     std::size_t j = 0;
     for (std::size_t i = 0; i < n; ++i) {
       NodeSpan& sp = out.span[drawn.strand_begin(strand) + i];
       while (j + 2 < sn.arc.size() && sn.arc[j + 1] <= s[i]) ++j;
-      const std::size_t on = sn.arc[j] == s[i] ? j : j + 1;
-      if (rest[i].w() == 0.0f && sn.pinned[on] && sn.arc[on] == s[i]) {
-        sp.kind = NodeSpan::Kind::Node;
-        sp.a = static_cast<std::int32_t>(on);
-        continue;
-      }
-      if (held) continue;  // Kind::Head
+      if (held || rest[i].w() == 0.0f) continue;  // Kind::Head
       const double len = sn.arc[j + 1] - sn.arc[j];
       sp.kind = NodeSpan::Kind::Segment;
       sp.a = static_cast<std::int32_t>(j);
@@ -186,7 +177,6 @@ void draw_from_nodes(std::span<const Vec4f> node_pos, std::span<const Vec4f> nod
         drawn[i].head<3>() = pa + sp.t * (pb - pa) + frame[sp.a].slerp(sp.t, frame[sp.a + 1]) * sp.offset;
         break;
       }
-      case NodeSpan::Kind::Node: drawn[i].head<3>() = xyz(node_pos[sp.a]); break;
       case NodeSpan::Kind::Head: drawn[i].head<3>() = head * xyz(drawn_rest[i]); break;
     }
     drawn[i].w() = drawn_rest[i].w();

@@ -7,8 +7,8 @@
 //
 // Nodes sit on the rest polyline, spaced equally in arc length between anchors: the
 // strand's first and last vertex and every pinned vertex are nodes themselves, so that a
-// pin passes to the simulation unchanged (a pinned vertex is drawn exactly where the head
-// carries it). A drawn vertex keeps its rest offset from the point of its node segment at
+// pin passes to the simulation unchanged; a pinned vertex is drawn exactly where the head
+// carries it, whether or not the model holds a node there. A drawn vertex keeps its rest offset from the point of its node segment at
 // its arc length, in that segment's frame: §5.5 stores a local coordinate system per
 // vertex for its tangent and normal; here it carries the position too, so a curl finer
 // than the nodes keeps its shape (the drawn groom at rest is the rest groom).
@@ -28,11 +28,10 @@ using Mat3f = Eigen::Matrix3f;
 // Where one drawn vertex sits on its strand's nodes (indices within the strand):
 //  - Segment: between node `a` and node a+1, at fraction t of that segment, plus `offset`,
 //    its rest position less the segment's point at t;
-//  - Node: on node `a` itself, a pinned vertex, which moves as the model moves that node
-//    (the head carries it, unless the model frees it, as the cascade frees vertex 1);
-//  - Head: rigid with the head (a vertex of a static strand between its nodes).
+//  - Head: rigid with the head, head · rest: a pinned vertex (a node too, which the
+//    model moves with the head), and every vertex of a static strand.
 struct NodeSpan {
-  enum class Kind : std::uint8_t { Segment, Node, Head };
+  enum class Kind : std::uint8_t { Segment, Head };
   Kind kind = Kind::Head;
   std::int32_t a = 0;
   float t = 0.0f;
@@ -52,15 +51,12 @@ struct NodeLayout {
 // Lays every strand of `drawn` out as `count` nodes (at least its anchors: first, last and
 // pinned vertices). Free nodes go to the free stretches between anchors in proportion to
 // their arc length (largest remainders, ties to the earlier stretch); a stretch between
-// two adjacent pinned vertices is rigid and gets none. With `tied_static`, a strand whose
-// last vertex is pinned as well as its root (a tip tied to the head) is static: every node
-// and vertex of it rigid with the head, as §6.3's constraints declare "individual strands
-// and parts of strands" static, for a model that is a tree grown from the root and cannot
-// honour a second pin (the forest, §4.2). With `root_node_only` the vertices pinned after
-// the root are not anchors: the strand's nodes are spaced from its root node alone (the
-// cascade, §4.3: "node 0 is fixed to the scalp", node 1 simulated), and those vertices are
-// drawn from the first segment like the free ones.
-NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static = false, bool root_node_only = false);
+// two adjacent pinned vertices is rigid and gets none. With `tied_static`, a strand with a
+// pinned vertex after a free one (a tip tied to the head, a pin in the middle) is static:
+// every node and vertex of it rigid with the head, as §6.3's constraints declare
+// "individual strands and parts of strands" static, for a model that is a tree grown from
+// the root and cannot honour a second pin (the forest, §4.2).
+NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static = false);
 
 // One strand's drawn vertices from its nodes (§5.5 with rest offsets). Each node segment
 // j turns its rest frame by Q_j, the head's rotation carried down the strand by parallel
@@ -70,7 +66,7 @@ NodeLayout layout_nodes(const Groom& drawn, int count, bool tied_static = false,
 // spun. A node's frame is halfway between its two segments' and a drawn vertex's frame
 // is interpolated (slerp) between its segment's two nodes', so drawn vertices on either
 // side of a bent node turn alike. A drawn vertex is lerp(P_a, P_{a+1}, t) + R offset, R
-// its frame; one on a node is that node's position, one rigid with the head head · rest.
+// its frame; one rigid with the head is head · rest.
 // `frame` is scratch of one entry per node.
 void draw_from_nodes(std::span<const Vec4f> node_pos, std::span<const Vec4f> node_rest,
                      std::span<const NodeSpan> span, std::span<const Vec4f> drawn_rest, const Affine3f& head,

@@ -36,7 +36,7 @@ ParamSet nodes_for_groom(const Groom& g, const ParamSet& p) {
 StepBound bound_at_nodes(BoundFn bound, const NodeTraits& traits, const Groom& g, const ParamSet& given,
                          const Vec3f& gravity) {
   const ParamSet p = nodes_for_groom(g, given);
-  const kernels::NodeLayout layout = kernels::layout_nodes(g, p.get_int("nodes"), traits.tied_static, traits.root_node_only);
+  const kernels::NodeLayout layout = kernels::layout_nodes(g, p.get_int("nodes"), traits.tied_static);
   StepBound b = bound(layout.nodes, at_nodes(p, traits.scaling), gravity);
   b.why += " (at " + std::to_string(p.get_int("nodes")) + " nodes)";
   return b;
@@ -48,7 +48,7 @@ NodesModel::NodesModel(std::unique_ptr<HairModel> inner, const NodeTraits& trait
 void NodesModel::reset(const Groom& rest, const ParamSet& given) {
   rest_ = rest;
   params_ = nodes_for_groom(rest, given);
-  layout_ = kernels::layout_nodes(rest, params_.get_int("nodes"), traits_.tied_static, traits_.root_node_only);
+  layout_ = kernels::layout_nodes(rest, params_.get_int("nodes"), traits_.tied_static);
   inner_->reset(layout_.nodes, at_nodes(params_, traits_.scaling));
   drawn_ = rest.positions;
   frame_.resize(layout_.nodes.vertex_count());

@@ -48,22 +48,17 @@ inline constexpr std::array<NodeScaling, 0> kSpringScaling{};
 inline constexpr std::array<NodeScaling, 1> kCascadeScaling{{{"stiffness", 3.6}}};
 inline constexpr std::array<NodeScaling, 2> kForestScaling{{{"joint_stiffness", 2.0}, {"joint_damping", 2.0}}};
 
-// How one model is laid out on nodes (kernels::layout_nodes): its scaled parameters;
+// How one model is laid out on nodes (kernels::layout_nodes): its scaled parameters, and
 // whether strands pinned at both ends are held static (the forest, a tree grown from the
 // root, cannot honour a second pin and holds such strands static, §6.3; the spring and
-// cascade models, whose nodes are particles, honour both pins); and whether the nodes are
-// spaced from the root node alone (the cascade, which fixes node 0 only and simulates node
-// 1, §4.3: anchored at the groom's pinned vertex 1, a few millimetres from the root, its
-// first segment would be a short lever whose springs hardly turn the strand about its
-// root, and a strand at 4 nodes took over 15 s to swing back after `walk`).
+// cascade models, whose nodes are particles, honour every pin).
 struct NodeTraits {
   std::span<const NodeScaling> scaling;
   bool tied_static;
-  bool root_node_only;
 };
-inline constexpr NodeTraits kSpringNodes{kSpringScaling, false, false};
-inline constexpr NodeTraits kCascadeNodes{kCascadeScaling, false, true};
-inline constexpr NodeTraits kForestNodes{kForestScaling, true, false};
+inline constexpr NodeTraits kSpringNodes{kSpringScaling, false};
+inline constexpr NodeTraits kCascadeNodes{kCascadeScaling, false};
+inline constexpr NodeTraits kForestNodes{kForestScaling, true};
 
 // Verlet's `damping` (spring and cascade) is given per sixth of a frame, a substep at the
 // models' default six, and taken per substep as the same damping per frame: the substeps

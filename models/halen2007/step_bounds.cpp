@@ -27,7 +27,8 @@ double max_param(const Groom& g, const ParamSet& p, const char* name) {
 }
 
 // The shortest rest edge with a free end, and the largest ratio of a free edge to the
-// edge before it.
+// free edge before it (a segment pinned at both ends is the head's: a spring's reaction
+// on it moves nothing).
 struct Edges {
   double shortest = std::numeric_limits<double>::infinity();
   double ratio = 1.0;
@@ -44,7 +45,7 @@ Edges free_edges(const Groom& g) {
         e.shortest = std::min(e.shortest, l);
         if (before > 0.0) e.ratio = std::max(e.ratio, l / before);
       }
-      before = l;
+      before = free ? l : 0.0;
     }
   }
   return e;
@@ -70,6 +71,28 @@ StepBound explicit_spring_bound(const Groom& g, double k, const Vec3f& gravity, 
 }
 
 }  // namespace
+
+StepBound travel_bound(const Groom& g, const ParamSet& /*p*/, const Vec3f& gravity) {
+  double shortest = std::numeric_limits<double>::infinity();
+  std::vector<double> free;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    const std::uint32_t b = g.strand_begin(s), n = g.strand_size(s);
+    free.clear();
+    for (std::uint32_t i = 1; i < n; ++i)
+      if (g.positions[b + i].w() != 0.0f || g.positions[b + i - 1].w() != 0.0f)
+        free.push_back((g.positions[b + i] - g.positions[b + i - 1]).head<3>().cast<double>().norm());
+    if (free.empty()) continue;
+    std::nth_element(free.begin(), free.begin() + static_cast<std::ptrdiff_t>(free.size() / 2), free.end());
+    shortest = std::min(shortest, free[free.size() / 2]);
+  }
+  StepBound b;
+  const double gn = gravity.cast<double>().norm();
+  b.max_step = gn > 0.0 && std::isfinite(shortest) ? std::sqrt(kEdgeTravel * shortest / (2.0 * gn))
+                                                   : std::numeric_limits<double>::max();
+  b.why = "travel: 2|g|h^2 <= " + num(kEdgeTravel) + " x the shortest median free edge of a strand (" +
+          num(shortest) + " m)";
+  return b;
+}
 
 StepBound spring_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity) {
   const double k = max_param(g, p, "stiffness");

@@ -31,6 +31,14 @@ inline constexpr double kOmegaStep = 1.0;
 // shorter), which 16 substeps meet there.
 inline constexpr double kEdgeTravel = 0.05;
 
+// For Han & Harada's position-based models, sqrt(kEdgeTravel e_min / (2 |g|)) with e_min
+// the shortest of the strands' median free edges: unconditionally stable, their length
+// constraints see a substep's travel only after it, and a few Gauss-Seidel iterations
+// leave part of it as stretch along the whole strand, which the stretched verdict reads in
+// the strand's median edge. A single short edge is not the scale here, as it is for the
+// explicit models' fold. No parameter enters.
+StepBound travel_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity);
+
 // halen_spring: min(kOmegaStep / sqrt(k_max), sqrt(kEdgeTravel l_min / (2 |g|))), k_max
 // the strongest spring (§5.9's falloff holds it at `stiffness` near the root) and l_min
 // the shortest rest edge with a free end.

@@ -186,14 +186,19 @@ TfxAsset load_tfx_asset(const std::filesystem::path& file, const ImportOptions& 
 // Guides shorter than `rigid_below` metres, and their follow hairs, are pinned whole.
 TfxAsset load_tfx_project(const std::filesystem::path& file, const ImportOptions& opt, std::uint64_t seed);
 
-// Shrinks each sphere, keeping its centre, until no free vertex of `g` lies inside it or
-// on it: a shrunk sphere's radius is kColliderClearance short of the nearest free
-// vertex's distance. Exactly on the surface, rounding would decide whether a model finds
+// Shrinks each sphere, keeping its centre, until no free vertex of `g` (with `pinned_too`,
+// no vertex at all) lies inside it or on it: a shrunk sphere's radius is
+// kColliderClearance short of the nearest such vertex's distance. A TressFX project's
+// spheres keep the roots they are authored over; a sphere fitted to a groom
+// (`"radius": "fit"`) clears the pinned vertices too, since a pinned vertex inside holds
+// its free neighbour against the surface, and pushed out, that edge stretches from the
+// first frame (TestHair1's fitted 0.54 m collider held 0.1 of its roots: the cascade's
+// strand 1638 stretched 0.86 of its median edge). Exactly on the surface, rounding would decide whether a model finds
 // that vertex inside (a sphere evaluated under the head transform, a distance computed in
 // another order) and push it out at the first step: on TestHair1 tiled to 50,000 strands
 // under `spin_fast`, `plante_wisp`'s two strands that touched the sphere kept bouncing
 // off it with the head still (§4.2's reaction lifts a mass found inside 1.8 mm out).
 inline constexpr float kColliderClearance = 1e-3f;  // of the distance
-void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g);
+void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g, bool pinned_too = false);
 
 }  // namespace hairbench::tfx

@@ -85,11 +85,11 @@ Sphere to_metres(const Sphere& s, float metres_per_unit, const std::string& sour
 
 }  // namespace
 
-void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g) {
+void fit_spheres_to_rest_hair(std::vector<Sphere>& spheres, const Groom& g, bool pinned_too) {
   for (Sphere& s : spheres) {
     float nearest = std::numeric_limits<float>::infinity();
     for (const Vec4f& p : g.positions)
-      if (p.w() != 0.0f) nearest = std::min(nearest, (p.head<3>() - s.center).norm());
+      if (pinned_too || p.w() != 0.0f) nearest = std::min(nearest, (p.head<3>() - s.center).norm());
     if (nearest <= s.radius) s.radius = nearest * (1.0f - kColliderClearance);
   }
 }

@@ -72,7 +72,6 @@ void cascade_setup(std::span<const Vec4f> rest, float stiffness, float c, int ex
     base[i] = -1;
     up_local[i] = down_local[i] = Vec3f::Zero();
   }
-  inv_mass[1] = n > 2 ? rest[2].w() : 1.0f;
   for (std::size_t j = 1; j < n; ++j) {
     const int b = edge[j] < tiny ? base[j - 1] : static_cast<int>(j) - 1;
     base[j] = b;

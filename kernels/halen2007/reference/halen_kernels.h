@@ -62,11 +62,12 @@ enum class CascadeFrames : int {
 void spring_setup(std::span<const Vec4f> rest, float stiffness, float c, int exponent, std::span<float> k,
                   std::span<float> lift);
 
-// §4.3 with §5.9's falloff and downward fraction, one strand. The thesis fixes only node 0
-// to the scalp; node 1 is simulated, with its upward reference node in the given tangent
-// space at the root. Writes:
-//  - inv_mass: the groom's inverse masses with vertex 1 freed (it takes vertex 2's, 1 on a
-//    two-vertex strand); a groom that pins vertex 2 as well keeps vertex 1 pinned;
+// §4.3 with §5.9's falloff and downward fraction, one strand. The thesis fixes node 0 to
+// the scalp, node 1's upward reference node in the given tangent space at the root; here
+// the groom's pins are kept, so its pinned root edge (vertices 0 and 1, the root frame
+// every groom gives) is that given space, held rigid with the head, as in every other
+// model. Writes:
+//  - inv_mass: the groom's inverse masses, which the springs read;
 //  - k_up (vertices 1..n) and k_down (vertices 1.. with a segment two below them), the
 //    lift 1/(k_up + k_down) per unit gravity (L = mg/k with both reference nodes
 //    displaced alike, "half the distance" when they are equally strong);
@@ -98,7 +99,7 @@ void tangent_spaces(std::span<const Vec4f> pos, const Mat3f& root, CascadeFrames
 
 // One strand's constant set-up (cascade_setup), as cascade_accelerations reads it.
 struct CascadeStrand {
-  std::span<const float> inv_mass;      // the cascade's own: vertex 1 free
+  std::span<const float> inv_mass;      // the groom's
   std::span<const float> k_up, k_down;  // per unit node mass, s^-2
   std::span<const float> lift;          // per unit gravity
   std::span<const int> base;

@@ -168,21 +168,13 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
       inv_length_[s] = k::forest_setup(strand_rest, axes, static_cast<float>(params.get("joint_stiffness", r)), c, a,
                                        at(space), at(theta0), at(phi0), at(length), at(k_up));
   }
+  const bool cascade = !spring && !forest;
   if (forest_rest_.hold) {
     forest_rest_.positions = rest.positions;
     forest_rest_.length = length;
     forest_rest_.k = k_up;
     forest_rest_.strand_offsets = rest.strand_offsets;
   }
-  const bool cascade = !spring && !forest;
-  if (cascade)  // the cascade's own inverse masses (vertex 1 free) decide its rows' kinds
-    for (const BlockInfo& b : blocks_)
-      for (int v = 0; v < b.n; ++v) {
-        int pinned = 0;
-        for (int l = 0; l < W; ++l) pinned += inv_mass[b.offset_of[l] + static_cast<std::size_t>(v)] == 0.0f;
-        row_kinds_[b.rows + static_cast<std::size_t>(v)] =
-            pinned == 0 ? soa::kRowFree : pinned == W ? soa::kRowPinned : soa::kRowMixed;
-      }
   for (const BlockInfo& b : blocks_) {
     float* d = data_.data() + b.offset;
     float* st = state_.data() + b.state;
@@ -215,7 +207,7 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
         row(d, soa::RX, i, l) = p0.x();
         row(d, soa::RY, i, l) = p0.y();
         row(d, soa::RZ, i, l) = p0.z();
-        row(d, soa::IW, i, l) = cascade ? inv_mass[v] : p0.w();
+        row(d, soa::IW, i, l) = p0.w();
         row(d, soa::RL, i, l) = rest_length[v];
         row(d, soa::LIFT, i, l) = lift[v];
         row(d, soa::KU, i, l) = k_up[v];

@@ -36,9 +36,6 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
                      strand(k_up_, s), strand(k_down_, s), strand(lift_, s), strand(base_, s), strand(lever_, s),
                      strand(rest_space_, s), strand(up_local_, s), strand(down_local_, s));
   }
-  // The cascade's own inverse masses (vertex 1 free): follow_head moves the vertices its
-  // rest copy pins, the other kernels read the positions' w.
-  for (std::size_t i = 0; i < nv; ++i) rest_.positions[i].w() = pos_[i].w() = inv_mass_[i];
   space_ = rest_space_;
   acc_.assign(nv, Vec3f::Zero());
   twist_.assign(nv, 0.0f);

@@ -2,8 +2,9 @@
 // step carry two reference nodes per free strand node, an upward one in the space of
 // the segment above it and a downward one in the space of the segment two below it;
 // zero-rest-length springs F = kL pull the node to both (Verlet, Eq. 4.1), then edge
-// corrections (Eq. 4.2). Only node 0 is fixed; node 1's upward reference node is in the
-// given space at the root. Each spring is half of the torsion spring the reference nodes
+// corrections (Eq. 4.2). The thesis fixes node 0, node 1's upward reference node in the
+// given space at the root; the groom's pinned root edge is that space, and every pin the
+// groom has is kept. Each spring is half of the torsion spring the reference nodes
 // simulate: its elastic part pushes back on the segment that carries its space
 // (kernels::cascade_accelerations). The reference nodes are displaced upward, rigidly
 // with the head, to carry the nodes' weight at rest; spring strength falls with the
@@ -47,7 +48,7 @@ class CascadeModel final : public HairModel {
   std::vector<kernels::Mat3f> rest_space_, space_;  // [B N T] per segment (by end vertex)
   std::vector<Vec3f> up_local_, down_local_;        // reference nodes in their spaces
   std::vector<float> lift_;                         // upward displacement per unit gravity
-  std::vector<float> inv_mass_;                     // the groom's, vertex 1 freed
+  std::vector<float> inv_mass_;                     // the groom's
   std::vector<int> base_;                           // rigid segment carrying each space
   std::vector<float> lever_;                        // ... and its rest length
   std::vector<Vec3f> acc_;                          // the springs' accelerations, this substep
