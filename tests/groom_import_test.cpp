@@ -126,41 +126,6 @@ TEST(HeadFit, ShippedAssetsGiveTheirBuiltInUnitOrARefusal) {
   EXPECT_NE(why.find("--fit-above"), std::string::npos) << why;
 }
 
-// The robust fit: the mohawk's roots run from its crown down its neck and back, and all of
-// them fit a 53 cm sphere (RMS residual 0.05 of it, a cap: shaped like a scalp). The
-// consensus finds the crown: a sphere of a head's size, 8-15 cm, near the built-in
-// scenario's hand fit, through under half the roots, in cm and in metres alike, with the
-// unit given or not. Its crown alone (the roots above 75 cm) fits the same head.
-TEST(HeadFit, ConsensusFindsTheMohawksCrownNotItsNeck) {
-  Groom cm = tfx::read_tfx_strands(kMohawk);
-  Groom m = cm;
-  for (Vec4f& p : m.positions) p.head<3>() *= 0.01f;
-  for (const auto& [groom, mpu, units] :
-       {std::tuple{&cm, 0.01f, std::vector<float>{}}, std::tuple{&cm, 0.01f, std::vector<float>{0.01f}},
-        std::tuple{&m, 1.0f, std::vector<float>{}}, std::tuple{&m, 1.0f, std::vector<float>{1.0f}}}) {
-    const HeadFit fit = fit_head(*groom, std::nullopt, units);
-    SCOPED_TRACE("metres per unit " + std::to_string(mpu) + (units.empty() ? ", unit guessed" : ", unit given"));
-    EXPECT_EQ(fit.method, "consensus");
-    EXPECT_TRUE(fit.scalp) << fit.note;
-    EXPECT_GE(fit.radius * mpu, kHeadPriorMin);
-    EXPECT_LE(fit.radius * mpu, kHeadPriorMax * (1 + 1e-6));
-    expect_near(fit.center * (mpu / 0.01f), Vec3f(-0.15f, 74.52f, 13.0f), 3.0f);
-    EXPECT_EQ(fit.roots, 2226u);
-    EXPECT_GT(fit.rejected.size(), 1000u);  // the neck and back
-    EXPECT_LT(fit.rejected.size(), 1500u);
-    // The rejected roots are the low ones: none of the crown's above 80 cm.
-    for (std::uint32_t s : fit.rejected) EXPECT_LT(groom->positions[groom->strand_begin(s)].y() / (mpu / 0.01f), 80.0f);
-  }
-  std::vector<std::uint32_t> crown;
-  for (std::uint32_t s = 0; s < cm.strand_count(); ++s)
-    if (cm.positions[cm.strand_begin(s)].y() > 75.0f) crown.push_back(s);
-  const HeadFit top = fit_head(select_strands(cm, crown));
-  EXPECT_EQ(top.method, "consensus");
-  EXPECT_NEAR(top.radius, 15.15f, 1.0f);
-  expect_near(top.center, Vec3f(-0.15f, 74.52f, 13.0f), 1.0f);
-  EXPECT_LT(top.rejected.size(), crown.size() / 10);
-}
-
 // Roots on a 10 cm scalp cap (from 0.3 of the radius below the centre up) and down a
 // neck under it (a column of 6 cm radius, its axis 2 cm behind the centre, from 9 to 30 cm
 // below it): the fit is the scalp, and what it rejects is the neck. The neck's top few
@@ -342,33 +307,6 @@ TEST(GroomScenario, FitsEverythingFromTheGroomAlone) {
   EXPECT_EQ(error_of([] { groom_scenario_json(kMohawk, "x", "moonwalk", "auto"); }).rfind(
                 "--motion: moonwalk: not a built-in scenario (one of: ", 0),
             0u);
-}
-
-// Without --fit-above: the mohawk with its unit given, guessed, and as a metres copy with
-// "m" fits a head of 8-15 cm through its crown's roots; the import says how many roots it
-// rejected.
-TEST(GroomScenario, FitsTheMohawksHeadWithoutBeingToldWhere) {
-  Groom metres = tfx::read_tfx_strands(kMohawk);
-  for (Vec4f& p : metres.positions) p.head<3>() *= 0.01f;
-  const fs::path copy = fs::temp_directory_path() / "hairbench_mohawk_in_metres.tfx";
-  tfx::write_tfx_v4(copy, metres);
-  for (const auto& [file, unit, mpu] :
-       {std::tuple{kMohawk, "cm", 0.01f}, std::tuple{kMohawk, "auto", 0.01f}, std::tuple{copy, "m", 1.0f}}) {
-    SCOPED_TRACE(file.string() + " " + unit);
-    const nlohmann::json doc = groom_scenario_json(file, file.string(), "shake", unit);
-    const Scenario sc = load_scenario_text(doc.dump(), fs::temp_directory_path() / "mohawk_shake.json");
-    ASSERT_TRUE(sc.import);
-    EXPECT_EQ(sc.import->fit.method, "consensus");
-    EXPECT_GE(sc.head_radius, kHeadPriorMin);
-    EXPECT_LE(sc.head_radius, kHeadPriorMax * (1 + 1e-6));
-    expect_near(sc.import->pivot * (mpu / 0.01f), Vec3f(-0.15f, 74.52f, 13.0f), 3.0f);
-    EXPECT_GT(sc.import->fit.rejected.size(), 1000u);
-    const std::string summary = import_summary(sc);
-    EXPECT_NE(summary.find("head fit on " + std::to_string(2226 - sc.import->fit.rejected.size()) + " of 2226 roots (" +
-                           std::to_string(sc.import->fit.rejected.size()) + " rejected"),
-              std::string::npos)
-        << summary;
-  }
 }
 
 // A scalp-shaped sphere no head has is refused with the radius, the unit and the options:

@@ -122,8 +122,11 @@ TEST(ReproducePlante, QuickRunGivesEveryRow) {
   ASSERT_NE(inter, r.measurements.end());
   ASSERT_EQ(inter->columns.size(), 3u);
   for (std::size_t i = 0; i < inter->columns.size(); ++i)
-    for (const auto& row : pub["tables"]["section_5_3"]["rows"])
-      if (row[0] == inter->columns[i]) EXPECT_EQ(inter->published[i], row[3].get<double>()) << inter->columns[i];
+    for (const auto& row : pub["tables"]["section_5_3"]["rows"]) {
+      if (row[0] == inter->columns[i]) {
+        EXPECT_EQ(inter->published[i], row[3].get<double>()) << inter->columns[i];
+      }
+    }
   for (const reproduce::MeasurementRow& row : r.measurements) {
     EXPECT_EQ(row.published.size(), row.columns.size()) << row.id;
     EXPECT_EQ(row.measured.size(), row.columns.size()) << row.id;
