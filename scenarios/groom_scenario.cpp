@@ -103,8 +103,9 @@ std::string import_summary(const Scenario& sc) {
       os << "fit on " << used << " of " << f.roots << " roots";
       if (f.method == "consensus") os << " (" << f.rejected.size() << " rejected: off the scalp's sphere)";
       else if (f.method == "above") os << " (" << f.rejected.size() << " rejected: at or below --fit-above)";
-      os << ": centre [" << text(c.x()) << ", " << text(c.y()) << ", " << text(c.z()) << "] file units, radius " << text(f.radius, "%.4f") << " m, RMS residual "
-         << text(f.rms_residual * 1e3, "%.3g") << " mm" << (f.scalp ? "" : "; " + f.note);
+      os << ": centre [" << text(c.x()) << ", " << text(c.y()) << ", " << text(c.z()) << "] file units, radius "
+         << text(f.radius, "%.4f") << " m, RMS residual " << text(f.rms_residual * 1e3, "%.3g") << " mm"
+         << (f.scalp ? "" : "; " + f.note);
     }
   }
   os << "; " << repairs_text(im.repairs) << "\n";

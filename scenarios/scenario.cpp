@@ -525,11 +525,12 @@ ImportedGroom read_imported_groom(const Obj& g, float head_radius, bool head_rad
   if (head_radius_fit) {
     // A scalp-shaped sphere no head has: the unit is wrong, or the fit found another surface.
     if (info.fit.scalp && !(info.fit.radius >= kHeadRadiusMin && info.fit.radius < kHeadRadiusMax))
-      r.fail("head.radius", "the roots fit a scalp-shaped sphere of radius " + num_text(info.fit.radius) +
-                                " m, outside a head's [" + num_text(kHeadRadiusMin) + ", " + num_text(kHeadRadiusMax) +
-                                ") m, with the unit " + info.unit + " (" + (info.unit_from == "given" ? "given" : "guessed") +
-                                "); give the unit (--unit, \"unit\"), fit on the scalp's roots (--fit-above, "
-                                "\"fit_above\") or give head.radius and the pivot");
+      r.fail("head.radius",
+             "the roots fit a scalp-shaped sphere of radius " + num_text(info.fit.radius) + " m, outside a head's [" +
+                 num_text(kHeadRadiusMin) + ", " + num_text(kHeadRadiusMax) + ") m, with the unit " + info.unit + " (" +
+                 (info.unit_from == "given" ? "given" : "guessed") +
+                 "); give the unit (--unit, \"unit\"), fit on the scalp's roots (--fit-above, \"fit_above\") or give "
+                 "head.radius and the pivot");
     if (!(info.fit.radius > 0.0f && info.fit.radius <= 1.0f))
       r.fail("head.radius", "the fitted head radius is " + num_text(info.fit.radius) +
                                 " m, outside (0, 1] (check the groom's unit)");

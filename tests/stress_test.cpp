@@ -1,5 +1,7 @@
-// `hairbench stress`: the energy-growth failure criterion, the degenerate grooms (each runs
-// or is refused at load, never diverges), and a short stress set.
+// `hairbench stress`: the energy-growth failure criterion and the degenerate grooms (each
+// runs or is refused at load, never diverges); stress_set_test.cpp runs a short stress set.
+#include "stress_support.h"
+
 #include "core/parallel.h"
 #include "harness/stress.h"
 #include "models/registry.h"
@@ -15,21 +17,6 @@ namespace {
 
 using metrics::EnergyGrowthCheck;
 constexpr int kFramesToFail = EnergyGrowthCheck::kWindow * (EnergyGrowthCheck::kWindows + 1);
-
-// The models the verdicts find unstable on some of these grooms (docs/verdicts.md): the
-// forest (explicit joint integration where strands crowd or start inside a collider).
-bool known_unstable(const std::string& model) {
-  for (const char* m : {"halen_forest"})
-    if (model.rfind(m, 0) == 0) return true;
-  return false;
-}
-
-std::vector<std::string> all_models() {
-  std::vector<std::string> names;
-  for (const ModelInfo& m : model_registry())
-    if (m.platform == Platform::Cpu) names.emplace_back(m.name);  // the CPU models, as hairbench stress
-  return names;
-}
 
 TEST(EnergyGrowthCheck, SustainedGrowthWithTheHeadStillFails) {
   // L-bar 0.25 m, g 9.81: the threshold is 0.05 * 9.81 * 0.25 = 0.123 J/kg per window.
@@ -53,7 +40,7 @@ TEST(EnergyGrowthCheck, DecayOrSlowGrowthOrDrivenGrowthPasses) {
 TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
   ThreadPool pool(2);
   StressOptions opt;
-  opt.models = all_models();
+  opt.models = test::stress_models();
   opt.axes = "none";  // degenerate grooms only
   const StressResult r = run_stress(opt, pool);
   ASSERT_EQ(r.degenerate.size(), 5 * opt.models.size());
@@ -65,7 +52,7 @@ TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
       EXPECT_EQ(d.status, "refused");
       EXPECT_NE(d.reason.find("zero_length_edge"), std::string::npos);
       EXPECT_NE(d.reason.find("zero-length edge"), std::string::npos);
-    } else if (known_unstable(d.model)) {
+    } else if (test::known_unstable(d.model)) {
       // Reported as unstable where they are (known_unstable), never as a blow-up.
       EXPECT_TRUE(d.status == "ok" || d.status == "unstable") << d.status;
     } else if (d.model.rfind("plante_wisp", 0) == 0 && d.name == "inside_collider") {
@@ -84,43 +71,6 @@ TEST(Stress, DegenerateGroomsRunStablyOrAreRefusedForEveryModel) {
       EXPECT_EQ(d.status, "ok");  // these are valid grooms: every model must cope
     }
   }
-}
-
-TEST(Stress, ShortSetEscalatesUntilFailureAndKeepsTheBaseStable) {
-  ThreadPool pool(2);
-  StressOptions opt;
-  opt.models = all_models();
-  opt.keep_every = 100;  // 20 strands
-  opt.axes = "time_step|teleport";
-  opt.degenerate = false;
-  const StressResult r = run_stress(opt, pool);
-  ASSERT_EQ(r.axes.size(), 2 * opt.models.size());
-  for (const StressAxisResult& a : r.axes) {
-    SCOPED_TRACE(a.model + " / " + a.axis);
-    ASSERT_FALSE(a.cells.empty());
-    for (const StressCell& c : a.cells) {
-      // A failure always says why; a stable cell never carries a reason.
-      EXPECT_EQ(c.stable, c.reason.empty());
-      // The base scenario's own time step (1/60 s) is where every model is stable, but
-      // for those known to be unstable on some grooms (known_unstable).
-      if (a.axis == "time_step" && c.value == 1.0 / 60) {
-        if (known_unstable(a.model)) {
-          EXPECT_TRUE(c.stable || c.reason.rfind("unstable:", 0) == 0) << c.reason;
-        } else {
-          EXPECT_TRUE(c.stable) << c.reason;
-        }
-      }
-    }
-    // last stable < first failing, both from the tried values, when both exist.
-    if (a.first_failing && a.last_stable) {
-      EXPECT_LT(*a.last_stable, *a.first_failing);
-    }
-    if (a.first_failing) {
-      EXPECT_FALSE(a.reason.empty());
-    }
-  }
-  const nlohmann::json j = stress_json(r);
-  EXPECT_EQ(j["axes"].size(), r.axes.size());
 }
 
 }  // namespace
