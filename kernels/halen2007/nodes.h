@@ -8,10 +8,11 @@
 // Nodes sit on the rest polyline, spaced equally in arc length between anchors: the
 // strand's first and last vertex and every pinned vertex are nodes themselves, so that a
 // pin passes to the simulation unchanged; a pinned vertex is drawn exactly where the head
-// carries it, whether or not the model holds a node there. A drawn vertex keeps its rest offset from the point of its node segment at
-// its arc length, in that segment's frame: §5.5 stores a local coordinate system per
-// vertex for its tangent and normal; here it carries the position too, so a curl finer
-// than the nodes keeps its shape (the drawn groom at rest is the rest groom).
+// carries it, whether or not the model holds a node there. A drawn vertex keeps its rest
+// offset from the point of its node segment at its arc length, in that segment's frame:
+// §5.5 stores a local coordinate system per vertex for its tangent and normal; here it
+// carries the position too, so a curl finer than the nodes keeps its shape (the drawn
+// groom at rest is the rest groom).
 #pragma once
 
 #include "core/groom.h"
