@@ -8,6 +8,7 @@
 
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -103,6 +104,16 @@ struct Backend {
   std::string device;  // e.g. the Vulkan device's name; empty on the CPU
 };
 
+// TressFX follow hairs laid out on the guides, as scenarios/tfx's FollowHairs holds them
+// (tfx.h; the same fields, viewed).
+struct FollowHairsView {
+  std::span<const std::uint32_t> guide_offsets;   // the guides' strand offsets
+  std::span<const std::uint32_t> guide;           // per follow strand: its guide strand
+  std::span<const std::uint32_t> anchor;          // per follow strand: the guide vertex orienting its root frame
+  std::span<const std::uint32_t> follow_offsets;  // follow strand f: offsets [follow_offsets[f], [f + 1])
+  std::span<const Vec3f> offsets;                 // per follow vertex: (tangent, normal, binormal) offset
+};
+
 class HairModel {
  public:
   virtual ~HairModel() = default;
@@ -143,6 +154,15 @@ class HairModel {
   // given (Halén & Wester's nodes, at most a strand's vertices); the report shows these.
   // nullptr: the ones given.
   virtual const ParamSet* run_params() const { return nullptr; }
+  // A model that builds TressFX follow hairs from its guides itself (on its device, so
+  // that the guides need not come back to the host) takes their layout here, before
+  // reset(), and returns true; reset() then takes the guides expanded by the follow hairs.
+  // false: the harness rebuilds them on the host (harness/follow_adapter.h).
+  virtual bool set_follow_hairs(const FollowHairsView& /*follow*/) { return false; }
+  // Why the model cannot go on, once it cannot (a plugin that returned an error or threw
+  // across its boundary, or gave positions of the wrong size): the run stops there as
+  // diverged with this reason. Empty while the model runs.
+  virtual std::string failure() const { return {}; }
 };
 
 }  // namespace hairbench

@@ -12,9 +12,12 @@
 
 namespace hairbench {
 
-// What a parameter sets of the material a model describes, for `--calibrate`
-// (harness/calibrate.h): the one stiffness and the one damping it fits per model.
-enum class ParamRole { none, stiffness, damping };
+// What a parameter sets, for the runs that need to know (the plugin ABI's hb_param_role,
+// core/include/hairbench/plugin.h): `--calibrate` (harness/calibrate.h) fits the one
+// stiffness and reports the one damping per model; a cost knob repeats work that
+// converges (substeps, iterations); a chain-limit switch at its `chain_value` turns the
+// bending/shape terms off.
+enum class ParamRole { none, stiffness, damping, cost_knob, chain_limit };
 
 struct ParamSpec {
   std::string_view name;
@@ -24,6 +27,7 @@ struct ParamSpec {
   bool integer;
   std::string_view help;
   ParamRole role = ParamRole::none;
+  double chain_value = 0.0;  // ParamRole::chain_limit: the value that turns the term off
 };
 
 class ParamSet {

@@ -33,6 +33,7 @@ class FollowHairsAdapter final : public HairModel {
   const Groom* simulated_groom() const override { return inner_->simulated_groom(); }
   std::span<const Vec4f> simulated_positions() const override { return inner_->simulated_positions(); }
   const ParamSet* run_params() const override { return inner_->run_params(); }
+  std::string failure() const override { return inner_->failure(); }
 
  private:
   void rebuild();

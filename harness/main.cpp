@@ -7,6 +7,7 @@
 #include "harness/charts.h"
 #include "harness/gpu_clock.h"
 #include "harness/merge.h"
+#include "harness/plugin_loading.h"
 #include "harness/progress.h"
 #include "harness/reproduce.h"
 #include "harness/runner.h"
@@ -126,7 +127,24 @@ struct CompareArgs {
   RunOptions run;
   std::vector<std::string> skipped;  // models left out, and why (printed once the inputs are good)
   std::optional<KnobSpec> knob;
+  PluginLoad plugins;  // what load_plugins loaded and left out, for the report
 };
+
+// Why `m` does not run in a comparison on `device`, or "" when it does: it needs a device
+// that is missing; and, unless --models names it (`named`), it is a GPU model on a CPU
+// Vulkan device (lavapipe: seconds per frame) or a reference implementation (its fast
+// model's bits, slower).
+std::string why_not_run(const ModelInfo& m, const std::string& device, bool named) {
+  std::string why = m.unavailable ? m.unavailable(ModelContext{nullptr, device}) : "";
+#ifdef HAIRBENCH_HAS_VULKAN
+  if (why.empty() && m.platform == Platform::Vulkan && !named && vk::Context::get(device)->device().type == "CPU")
+    why = "the Vulkan device is a CPU (" + vk::Context::get(device)->device().name + "); name it in --models to run it";
+#endif
+  if (why.empty() && !named && !m.reference_of.empty())
+    why = std::string(m.reference_tolerance == 0.0 ? "bit-identical" : "rounding-level") +
+          " reference implementation of " + std::string(m.reference_of) + "; name it in --models to run it";
+  return why;
+}
 
 // --knob NAME=V1,V2,...: a parameter name and distinct finite numbers.
 KnobSpec parse_knob(const std::string& arg) {
@@ -204,27 +222,18 @@ void prepare_compare(CompareArgs& a, bool sweep) {
   // error when --models asked for them.
   for (const ModelInfo& m : model_registry()) {
     if (!std::regex_match(std::string(m.name), re)) continue;
-    std::string why = m.unavailable ? m.unavailable(ModelContext{nullptr, a.run.device}) : "";
-#ifdef HAIRBENCH_HAS_VULKAN
-    // On a CPU Vulkan device (lavapipe) the GPU models take seconds per frame: run them
-    // only when --models asks for them.
-    if (why.empty() && m.platform == Platform::Vulkan && !a.models_given &&
-        vk::Context::get(a.run.device)->device().type == "CPU")
-      why = "the Vulkan device is a CPU (" + vk::Context::get(a.run.device)->device().name +
-            "); name it in --models to run it";
-#endif
-    // A reference implementation gives its fast model's bits, slower.
-    if (why.empty() && !a.models_given && !m.reference_of.empty())
-      why = std::string(m.reference_tolerance == 0.0 ? "bit-identical" : "rounding-level") +
-            " reference implementation of " + std::string(m.reference_of) + "; name it in --models to run it";
+    const std::string why = why_not_run(m, a.run.device, a.models_given);
     if (why.empty()) a.run.models.emplace_back(m.name);
     else if (a.models_given) throw InputError("arguments", "--models", std::string(m.name) + " cannot run: " + why);
     else a.skipped.push_back(std::string(m.name) + ": " + why);
   }
   if (a.run.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model");
   if (a.run.reference == kConvergedReference) {
-    a.run.reference = "han_m1";
-    a.run.reference_overrides = converged_reference_overrides();
+    a.run.reference = kDefaultReference;
+    const ModelInfo* ref = find_model(a.run.reference);
+    if (!ref || ref->converged.empty())
+      throw InputError("arguments", "--reference", a.run.reference + " has no converged setting");
+    a.run.reference_overrides = converged_overrides(*ref);
   } else if (!a.run.reference.empty() && !find_model(a.run.reference)) {
     throw InputError("arguments", "--reference", "unknown model '" + a.run.reference + "' (or 'converged')");
   }
@@ -318,7 +327,8 @@ int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<Devic
     if (!d.clock_max_mhz) d.clock_max_mhz = clock.max_mhz;
   }
   const std::filesystem::path out = std::filesystem::path(a.out) / "report.json";
-  nlohmann::json report = make_report(ReportContext{pool.threads(), std::move(devices)}, runs, scenarios);
+  nlohmann::json report =
+      make_report(ReportContext{pool.threads(), std::move(devices), plugins_json(a.plugins)}, runs, scenarios);
   if (!sweep.is_null()) report["sweep"] = sweep;
   if (a.shard.active()) report["shard"] = shard_json(plan, a.shard);
   write_json(out, report);
@@ -630,8 +640,15 @@ int cmd_list(const std::string& what) {
       if (!m.reference_of.empty())
         line += "; the reference for " + std::string(m.reference_of) +
                 (m.reference_tolerance == 0.0 ? " (same bits)" : " (to rounding)");
+      if (!m.origin.empty()) line += " [plugin " + std::string(m.origin) + "]";
       std::printf("%-*s %s\n", width, std::string(m.name).c_str(), line.c_str());
     }
+    return 0;
+  }
+  // One name a line, for scripts (ci/perf-gate): the models a default comparison runs.
+  if (what == "compared") {
+    for (const ModelInfo& m : model_registry())
+      if (why_not_run(m, "", false).empty()) std::printf("%s\n", std::string(m.name).c_str());
     return 0;
   }
   if (what == "scenarios") {
@@ -653,7 +670,7 @@ int cmd_list(const std::string& what) {
     return 0;
   }
   throw InputError("arguments", "list " + what,
-                   "expected `list models`, `list scenarios`, `list presets` or `list devices`");
+                   "expected `list models`, `list compared`, `list scenarios`, `list presets` or `list devices`");
 }
 
 // --frames, --threads, --keep-every: a whole number in [lo, hi]. The one place numbers
@@ -756,8 +773,8 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
       ->each([&a](const std::string&) { a.models_given = true; });
   sub.add_option("--reference", a.run.reference,
                  "deviation is measured against MODEL (default: the\n"
-                 "scenario's, han_m1); converged: han_m1 with 32 local and\n"
-                 "length iterations and 4 substeps")
+                 "scenario's, " + std::string(kDefaultReference) + "); converged: " + std::string(kDefaultReference) +
+                     " at the settings\nwhere it is its own converged solution (docs/cli.md)")
       ->type_name("MODEL|converged");
   sub.add_option("--frames", a.run.frames, "frames per run, 1 to 10000000 (default: the scenario's)")
       ->type_name("N")
@@ -862,7 +879,8 @@ int run(int argc, char** argv) {
 
   std::string list_what;
   CLI::App* list = app.add_subcommand("list", kListHelp);
-  list->add_option("WHAT", list_what, "what to list")->type_name("models|scenarios|presets|devices");
+  list->add_option("WHAT", list_what, "what to list")->type_name("models|compared|scenarios|presets|devices");
+  std::vector<std::string> plugin_paths;
 
   CompareArgs compare_args, sweep_args;
   CLI::App* compare = app.add_subcommand("compare", kCompareHelp);
@@ -895,6 +913,13 @@ int run(int argc, char** argv) {
   CLI::App* reproduce = app.add_subcommand("reproduce", kReproduceHelp);
   add_reproduce_options(*reproduce, tables, reproduce_opt, reproduce_shard);
 
+  for (CLI::App* sub : {list, compare, sweep, stress})
+    sub->add_option("--plugin", plugin_paths,
+                    "load models from a plugin library (docs/plugins.md), after\nthe default ones and "
+                    "HAIRBENCH_PLUGIN_PATH's; repeatable")
+        ->type_name("PATH.so")
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+
   // Without arguments the usage is the answer, with the exit code of a bad command line;
   // `hairbench help` is a documented spelling of --help.
   if (argc < 2 || std::string_view(argv[1]) == "help") {
@@ -907,6 +932,8 @@ int run(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, -h, --version: printed on stdout
     throw argument_error(app, e);
   }
+  if (list->parsed() || compare->parsed() || sweep->parsed() || stress->parsed())
+    compare_args.plugins = sweep_args.plugins = load_plugins(plugin_paths);
   if (list->parsed()) return cmd_list(list_what);
   if (compare->parsed()) return run_batches(compare_args, false);
   if (sweep->parsed()) return run_batches(sweep_args, true);

@@ -13,9 +13,6 @@
 #include "reports/metrics.h"
 #include "reports/verdict.h"
 #include "scenarios/phases.h"
-#ifdef HAIRBENCH_HAS_VULKAN
-#include "models/han2012/vulkan/model.h"
-#endif
 
 #include <algorithm>
 #include <array>
@@ -162,7 +159,7 @@ std::optional<SubstepsChoice> choose_substeps(const ModelInfo& model, const Scen
     return c;
   }
   const Groom& simulated = sc.follow ? sc.guides : sc.groom;
-  const halen::StepBound bound = model.step_bound(simulated, resolved, sc.gravity);
+  const StepBound bound = model.step_bound(simulated, resolved, sc.gravity);
   c.source = "auto";
   c.max_step = bound.max_step;
   c.why = bound.why;
@@ -320,18 +317,12 @@ std::unique_ptr<HairModel> make_model(const ModelInfo& info, const Scenario& sc,
   ModelContext ctx{&pool, device};
   ctx.skip_inert = skip_inert;
   std::unique_ptr<HairModel> m = info.make(ctx);
-  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow"): on
-  // the device for a Vulkan model, so that its guides need not come back to the host.
+  // Follow hairs rebuilt from simulated guides (scenario groom.follow_hairs "follow"): by
+  // the model where it can (on its device), else on the host around it.
   if (sc.follow) {
-#ifdef HAIRBENCH_HAS_VULKAN
-    if (auto* vk = dynamic_cast<han_vk::HanVkModel*>(m.get())) {
-      const tfx::FollowHairs& f = *sc.follow;
-      vk->set_follow_hairs({f.guide_offsets, f.guide, f.anchor, f.follow_offsets, f.offsets});
-      m->reset(sc.groom, params);
-      return m;
-    }
-#endif
-    m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, *sc.follow, &pool);
+    const tfx::FollowHairs& f = *sc.follow;
+    if (!m->set_follow_hairs({f.guide_offsets, f.guide, f.anchor, f.follow_offsets, f.offsets}))
+      m = std::make_unique<FollowHairsAdapter>(std::move(m), sc.guides, f, &pool);
   }
   m->reset(sc.groom, params);
   return m;
@@ -362,8 +353,10 @@ FrameInput frame_input(const Scenario& sc, int f) {
   return in;
 }
 
-std::vector<ParamOverride> converged_reference_overrides() {
-  return {{"han_m1", "local_iterations", 32}, {"han_m1", "length_iterations", 32}, {"han_m1", "substeps", 4}};
+std::vector<ParamOverride> converged_overrides(const ModelInfo& model) {
+  std::vector<ParamOverride> out;
+  for (const ParamValue& v : model.converged) out.push_back({std::string(model.name), std::string(v.name), v.value});
+  return out;
 }
 
 namespace {
@@ -467,6 +460,7 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   r.setup_s = std::chrono::duration<double>(Clock::now() - twinned).count();
   r.scenario = sc_.name;
   r.model = std::string(info->name);
+  if (!info->origin.empty()) r.origin = std::string(info->origin);
   const Backend backend = lane.model->backend();
   r.backend = backend.name;
   r.device = backend.device;
@@ -603,7 +597,8 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
         continue;
       }
       const auto p = l.model->positions();
-      why[i] = metrics::blowup_reason(rest_, p, in.head.translation());
+      why[i] = l.model->failure();
+      if (why[i].empty()) why[i] = metrics::blowup_reason(rest_, p, in.head.translation());
       if (why[i].empty()) why[i] = l.energy.add(metrics::mechanical_energy(p, l.prev, sc_.dt, sc_.gravity), driven);
       l.kinetic = verdict::relative_kinetic_energy(p, l.prev, in.head, in.head_prev, sc_.dt);
       l.settle.add(in.t, l.kinetic, driven, sc_.settle_from);

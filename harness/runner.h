@@ -117,10 +117,11 @@ inline constexpr double kGpuWarmUpSeconds = 0.2;
 // the device time that does not depend on what runs beside the model.
 std::vector<double> back_to_back_gpu_ms(HairModel& model, const Scenario& sc, int frames);
 
-// The reference setting `--reference converged`: han_m1 iterated far past its defaults,
-// so that every model's deviation from it is an absolute error (method 1's included).
+// The reference setting `--reference converged`: the default reference at the settings
+// at which it is its own converged solution (ModelInfo::converged), so that every model's
+// deviation from it is an absolute error (the reference's own included).
 inline constexpr const char* kConvergedReference = "converged";
-std::vector<ParamOverride> converged_reference_overrides();
+std::vector<ParamOverride> converged_overrides(const ModelInfo& model);
 
 // The resolved scenario as a hash (16 hex digits): the loaded groom's bits, the head
 // script's keys and oscillators, the colliders, wind, gravity, time step, the first

@@ -30,40 +30,6 @@ ShardSpec parse_shard(const std::string& arg) {
 
 namespace {
 
-// The built-in cost table: median step time per vertex of each model at its default
-// parameters on the `shake` scenario (2,000 strands of 16 vertices, --no-skip, its first
-// 120 frames), 2 threads on the development machine (a 2-core x86-64 VM, idle), and how
-// the step grows with the parameters that repeat its work, from sweeps of them there. A model missing here (a
-// GPU model) is costed as its CPU method: the lockstep waits for it either way.
-struct TableEntry {
-  std::string_view model;
-  double ns;  // per vertex and step, at the defaults
-  // Whether its strands fall asleep when nothing drives them (plante_wisp's do not).
-  bool sleeps;
-  // A parameter the whole step scales with (substeps, an integration rate).
-  std::string_view multiplier;
-  // Parameters that repeat one stage: each unit above the default adds this share of the
-  // default step.
-  std::array<std::pair<std::string_view, double>, 2> linear;
-};
-
-constexpr TableEntry kTable[] = {
-    {"han_m1", 12.3, true, "substeps", {{{"local_iterations", 0.55}, {"length_iterations", 0.08}}}},
-    {"han_m2", 17.2, true, "substeps", {{{"local_iterations", 0.69}, {"length_iterations", 0.05}}}},
-    {"han_m3", 8.3, true, "substeps", {{{"local_iterations", 0.10}, {"length_iterations", 0.14}}}},
-    {"han_m1_ref", 247.0, true, "substeps", {{{"local_iterations", 0.55}, {"length_iterations", 0.08}}}},
-    {"han_m2_ref", 188.0, true, "substeps", {{{"local_iterations", 0.69}, {"length_iterations", 0.05}}}},
-    {"han_m3_ref", 102.0, true, "substeps", {{{"local_iterations", 0.10}, {"length_iterations", 0.14}}}},
-    {"halen_spring", 12.7, true, "substeps", {{{"length_iterations", 0.13}, {"", 0.0}}}},
-    {"halen_cascade", 69.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"halen_forest", 25.5, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"halen_spring_ref", 129.0, true, "substeps", {{{"length_iterations", 0.13}, {"", 0.0}}}},
-    {"halen_cascade_ref", 264.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"halen_forest_ref", 233.0, true, "substeps", {{{"", 0.0}, {"", 0.0}}}},
-    {"plante_wisp", 69.0, false, "integration_hz", {{{"", 0.0}, {"", 0.0}}}},
-    {"plante_wisp_ref", 251.0, false, "integration_hz", {{{"", 0.0}, {"", 0.0}}}},
-};
-
 // The lane's share of the lockstep that is not its step: the per-frame metrics
 // (deviation, jaggedness, length, rest shape, penetration, the verdicts' detectors), ns
 // of wall time per vertex and frame on the worker threads; measured as the unsharded
@@ -75,20 +41,10 @@ constexpr double kMetricsNsPerVertex = 7.0;
 constexpr double kSleepShare = 0.05;
 
 
-const TableEntry* table_entry(std::string_view model) {
-  // A model of another platform (han_m1_vk) is costed as its CPU method (han_m1).
-  for (const TableEntry& e : kTable)
-    if (e.model == model) return &e;
-  const auto cut = model.rfind('_');
-  if (cut != std::string_view::npos && model.substr(cut) == "_vk") return table_entry(model.substr(0, cut));
-  return nullptr;
-}
-
-// How much more a step costs at `params` than at the model's defaults (table_entry's
-// multiplier and linear terms); 1 for a model without an entry.
+// How much more a step costs at `params` than at the model's defaults (StepCost's
+// multiplier and linear terms).
 double param_scale(const ModelInfo& model, const ParamSet& params) {
-  const TableEntry* e = table_entry(model.name);
-  if (!e) return 1.0;
+  const StepCost* e = &model.cost;
   auto def = [&](std::string_view name) {
     for (const ParamSpec& p : model.params)
       if (p.name == name) return p.default_value;
@@ -102,15 +58,12 @@ double param_scale(const ModelInfo& model, const ParamSet& params) {
   return std::max(linear, 0.05) * mult;
 }
 
-double table_ns(std::string_view model) {
-  const TableEntry* e = table_entry(model);
-  // An unknown model: the slowest fused CPU model's cost, so that no shard is starved.
-  return e ? e->ns : 270.0;
-}
-
-bool sleeps(std::string_view model) {
-  const TableEntry* e = table_entry(model);
-  return !e || e->sleeps;
+// A model without a measured cost (a plugin that gives none) is costed as the slowest
+// model that has one, so that no shard is starved; the estimate's source says so.
+double slowest_known_ns() {
+  double ns = 0.0;
+  for (const ModelInfo& m : model_registry()) ns = std::max(ns, m.cost.ns_per_vertex);
+  return ns;
 }
 
 // The perturbation probe steps two copies of the model for 210 frames on at most 64
@@ -179,8 +132,12 @@ CostEstimate CostModel::run(const ModelInfo& model, const ParamSet& params, cons
                             std::size_t strands, std::size_t vertices, int frames, double work_fraction) const {
   const double vf = static_cast<double>(vertices) * frames;
   const double metrics = vf * kMetricsNsPerVertex * 1e-9;
-  double ns = table_ns(model.name);
+  double ns = model.cost.ns_per_vertex;
   std::string source = "table";
+  if (ns <= 0.0) {
+    ns = slowest_known_ns();
+    source = "unknown (" + std::string(model.name) + " gives no cost: the slowest model's)";
+  }
   if (const auto it = model_ns_.find(std::string(model.name)); it != model_ns_.end()) {
     ns = it->second;
     source = "costs: model";
@@ -190,7 +147,7 @@ CostEstimate CostModel::run(const ModelInfo& model, const ParamSet& params, cons
   // The same run measured before: its steps as they were, sleep included.
   if (const auto it = run_frame_seconds_.find(key); it != run_frame_seconds_.end())
     return {it->second * frames + metrics + probe, "costs: run"};
-  const double work = sleeps(model.name) ? work_fraction : 1.0;
+  const double work = model.cost.sleeps ? work_fraction : 1.0;
   const double steps = vf * (work + (1.0 - work) * kSleepShare);
   return {steps * ns * 1e-9 + probe + metrics, source};
 }

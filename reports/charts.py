@@ -199,7 +199,7 @@ def run_colour(colours, run, runs_of_model):
 
 def reference_text(run):
     dev = run["metrics"]["deviation_vs_reference"]
-    ref = dev.get("reference", "han_m1")
+    ref = dev["reference"]
     o = dev.get("reference_overrides")
     if o:
         ref += " (" + ", ".join(f"{k} {v:g}" for k, v in sorted(o.items())) + ")"
@@ -772,7 +772,7 @@ def overview(report):
     cells = {}
     for name in names:
         runs = [r for r in report["runs"] if r["scenario"] == name]
-        ref_model = runs[0]["metrics"]["deviation_vs_reference"].get("reference", "han_m1")
+        ref_model = runs[0]["metrics"]["deviation_vs_reference"]["reference"]
         # the reference model's own run at the scenario's parameters, when it is one of them
         ref_run = next((r for r in runs if r["model"] == ref_model
                         and r["metrics"]["deviation_vs_reference"]["max"] == 0), None)

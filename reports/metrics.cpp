@@ -299,7 +299,7 @@ METRIC_INLINE void lane_jaggedness(std::span<const Vec4f> p, const double* rest_
 
 // Strands are grouped by size at load (group_for_lanes): a ragged groom such as Table 1's
 // model 1 rarely has kLanes consecutive strands of one size, and the strands left alone
-// would take a large share of `compare --models han_m3` on it. Each strand's value is the
+// would take a large share of a fast model's comparison on it. Each strand's value is the
 // same either way, and they are added in index order: the same bits.
 METRIC_CLONES double jaggedness(const RestInfo& rest, std::span<const Vec4f> p) {
   const Groom& g = *rest.groom;

@@ -230,7 +230,10 @@ nlohmann::json context_json(const ReportContext& ctx) {
           {"threads", ctx.threads},
           {"build_type", HAIRBENCH_BUILD_TYPE},
           {"compiler", std::string("gcc-compatible ") + __VERSION__},
-          {"devices", devices}};
+          {"devices", devices},
+          {"plugins", ctx.plugins.is_null() ? nlohmann::json{{"loaded", nlohmann::json::array()},
+                                                              {"not_loaded", nlohmann::json::array()}}
+                                            : ctx.plugins}};
 }
 
 nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
@@ -318,6 +321,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
 
   nlohmann::json out = {{"scenario", r.scenario},
                        {"model", r.model},
+                       {"origin", r.origin},
                        {"backend", r.backend},
                        {"metrics_on", r.metrics_on},
                        {"groom", {{"strands", r.strands}, {"vertices", r.vertices}, {"static_strands", r.static_strands}}},

@@ -22,6 +22,7 @@ namespace hairbench {
 struct RunRecord {
   std::string scenario;
   std::string model;
+  std::string origin = "built-in";  // or the plugin library's path (ModelInfo::origin)
   std::string backend = "cpu";
   std::string device;  // the GPU a GPU model ran on (run "device"; context "devices")
   std::string metrics_on = "host";  // where the per-frame metrics were computed: "host" or "device"
@@ -149,6 +150,9 @@ struct DeviceRecord {
 struct ReportContext {
   int threads = 1;
   std::vector<DeviceRecord> devices;
+  // The plugin libraries loaded and the default ones left out (harness/plugin_loading.h);
+  // null: the caller loads none.
+  nlohmann::json plugins = nullptr;
 };
 
 nlohmann::json context_json(const ReportContext& ctx);

@@ -53,6 +53,10 @@ struct GroomImport {
   double seconds_fit = 0.0;  // guessing the unit, fitting the head sphere and the collider
 };
 
+// The model every other is measured against unless a scenario or --reference names
+// another: Han & Harada's method 1, the exact serial transforms (docs/metrics.md).
+inline constexpr const char* kDefaultReference = "han_m1";
+
 struct Scenario {
   std::string name;
   std::string description;
@@ -75,7 +79,7 @@ struct Scenario {
   std::vector<Sphere> colliders;
   WindScript wind;
   double settle_from = 0.0;
-  std::string reference = "han_m1";
+  std::string reference = kDefaultReference;
   std::map<std::string, ParamOverrides> models;  // "*" and model names, as in the file
   std::optional<GroomImport> import;              // set for an imported TressFX groom
   // Explicit models pick their substeps from the groom when nobody gives a number

@@ -74,7 +74,8 @@ TEST(Cli, VersionNamesTheBuiltCommit) {
 TEST(Cli, HelpNamesEveryOption) {
   const std::vector<std::string> run_options = {"--scenario", "--models",  "--reference", "--frames", "--threads",
                                                 "--set",      "--out",     "--no-charts", "--device", "--no-skip",
-                                                "--shard",    "--plan",    "--costs",     "--preset",  "--calibrate"};
+                                                "--shard",    "--plan",    "--costs",     "--preset",  "--calibrate",
+                                                "--plugin"};
   std::vector<std::string> sweep_options = run_options;
   sweep_options.push_back("--knob");
   struct Help {
@@ -83,17 +84,17 @@ TEST(Cli, HelpNamesEveryOption) {
   };
   const std::vector<Help> cases = {
       {"", {"--help", "--version", "list", "compare", "sweep", "stress", "merge", "reproduce"}, {"--frames"}},
-      {"list", {"--help", "models|scenarios|presets|devices"}, {"--out"}},
+      {"list", {"--help", "models|compared|scenarios|presets|devices", "--plugin"}, {"--out"}},
       {"compare", run_options, {"--knob", "--quick"}},
       {"sweep", sweep_options, {"--quick", "--keep-every"}},
       {"stress",
        {"--models", "--base", "--axes", "--keep-every", "--quick", "--threads", "--out", "--no-charts", "--shard",
-        "--plan", "--costs"},
+        "--plan", "--costs", "--plugin"},
        {"--scenario", "--set", "--knob", "--preset"}},
-      {"merge", {"OUT_DIR", "REPORT.json", "--mix-machines", "--no-charts"}, {"--frames", "--models", "--costs"}},
+      {"merge", {"OUT_DIR", "REPORT.json", "--mix-machines", "--no-charts"}, {"--frames", "--models", "--costs", "--plugin"}},
       {"reproduce",
        {"han2012", "halen2007", "plante2001", "all", "--frames", "--threads", "--device", "--out", "--shard", "--plan"},
-       {"--models", "--set", "--costs"}}};
+       {"--models", "--set", "--costs", "--plugin"}}};
   for (const Help& h : cases)
     for (const char* flag : {"--help", "-h"}) {
       const std::string args = h.sub + " " + flag;

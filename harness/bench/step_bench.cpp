@@ -28,7 +28,9 @@
 // work, real and deterministic (the same instruction count every run), so that
 // tests/perf_gate_e2e.sh can check that ci/perf-gate catches a known slowdown.
 // Unset or 0: no extra work.
+#include "core/error.h"
 #include "core/parallel.h"
+#include "harness/plugin_loading.h"
 #include "harness/roofline.h"
 #include "harness/runner.h"
 #include "reports/metrics.h"
@@ -39,6 +41,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -221,6 +224,13 @@ const bool registered = [] {
         ->UseManualTime()
         ->Iterations(1)
         ->Unit(benchmark::kMillisecond);
+  // The plugins a comparison loads (the default ones beside the binary, HAIRBENCH_PLUGIN_PATH):
+  // their models are timed like the built-in ones.
+  try {
+    load_plugins({});
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "hairbench_bench: %s\n", e.what());
+  }
   static std::vector<std::unique_ptr<Scenario>> scenarios;
   std::vector<Scenario> all = load_builtin_scenarios();
   for (Scenario& sc : paper_scenarios()) all.push_back(std::move(sc));

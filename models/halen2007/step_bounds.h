@@ -5,16 +5,12 @@
 
 #include "core/groom.h"
 #include "core/params.h"
+#include "core/step_bound.h"
 #include "core/types.h"
 
 #include <string>
 
 namespace hairbench::halen {
-
-struct StepBound {
-  double max_step = 0.0;  // seconds; 0 when no step is stable (the caller caps the count)
-  std::string why;        // the binding term with its numbers, for the report
-};
 
 // Verlet (Eq. 4.1) of a vertex held by a zero-rest-length spring of strength k per unit
 // mass is x'' = -k x, stable for omega h < 2 with omega = sqrt(k); we keep omega h <= 1.

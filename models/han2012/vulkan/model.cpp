@@ -52,7 +52,7 @@ HanVkModel::HanVkModel(han::Method method, const ModelContext& ctx)
 
 // What the follow kernel indexes with is checked here (as apply_follow_hairs checks its
 // layout), so that no layout can make it read or write out of bounds.
-void HanVkModel::set_follow_hairs(const FollowHairsView& f) {
+bool HanVkModel::set_follow_hairs(const FollowHairsView& f) {
   const auto fail = [](const char* what) { throw std::invalid_argument(std::string("set_follow_hairs: ") + what); };
   if (f.guide_offsets.empty() || f.guide_offsets.front() != 0) fail("guide offsets must start at 0");
   for (std::size_t g = 1; g < f.guide_offsets.size(); ++g)
@@ -79,6 +79,7 @@ void HanVkModel::set_follow_hairs(const FollowHairsView& f) {
   follow_guide_offsets_.assign(f.guide_offsets.begin(), f.guide_offsets.end());
   follow_strands_host_ = std::move(strands);
   follow_vertices_host_ = std::move(vertices);
+  return true;
 }
 
 namespace {

@@ -21,16 +21,6 @@
 
 namespace hairbench::han_vk {
 
-// TressFX follow hairs laid out on the guides, as scenarios/tfx's FollowHairs holds them
-// (tfx.h; the same fields, viewed).
-struct FollowHairsView {
-  std::span<const std::uint32_t> guide_offsets;   // the guides' strand offsets
-  std::span<const std::uint32_t> guide;           // per follow strand: its guide strand
-  std::span<const std::uint32_t> anchor;          // per follow strand: the guide vertex orienting its root frame
-  std::span<const std::uint32_t> follow_offsets;  // follow strand f: offsets [follow_offsets[f], [f + 1])
-  std::span<const Vec3f> offsets;                 // per follow vertex: (tangent, normal, binormal) offset
-};
-
 class HanVkModel final : public HairModel {
  public:
   // Opens (or shares) the Vulkan context of ctx.device; throws vk::Unavailable when
@@ -40,7 +30,7 @@ class HanVkModel final : public HairModel {
   // positions (apply_follow_hairs's formula, in float); call before reset(), which then
   // takes the guides expanded by the follow hairs (tfx::expand_follow_hairs) and
   // simulates the guides only. Throws std::invalid_argument for an inconsistent layout.
-  void set_follow_hairs(const FollowHairsView& follow);
+  bool set_follow_hairs(const FollowHairsView& follow) override;
   // Throws InputError for a strand longer than HAN_VK_MAX_STRAND_VERTICES.
   void reset(const Groom& rest, const ParamSet& params) override;
   // Uploads the frame's inputs, runs the dispatches and waits for them (stages "upload",
