@@ -400,13 +400,38 @@ int cmd_scenario_new(const std::string& groom_arg, const std::string& motion, co
 // compare and sweep: per scenario, one lockstep batch per knob value (one batch without
 // a knob), each running the plan's models of this shard (every model unsharded) beside
 // the reference, which every batch runs for itself.
-int run_batches(CompareArgs& a, bool sweep) {
-  prepare_compare(a, sweep);
+// --groom's options need --groom, and exclude --scenario.
+void check_groom_args(const CompareArgs& a) {
   if (!a.groom.empty() && !a.scenarios.empty())
     throw InputError("arguments", "--groom", "give either --groom or --scenario, not both");
   if (a.groom.empty() && !a.motions.empty()) throw InputError("arguments", "--motion", "applies to --groom only");
   if (a.groom.empty() && a.unit != "auto") throw InputError("arguments", "--unit", "applies to --groom only");
   if (a.groom.empty() && a.fit_above) throw InputError("arguments", "--fit-above", "applies to --groom only");
+}
+
+// Where a comparison's time went: stepping the models is what it measures; the rest is
+// overhead.
+struct TimeSplit {
+  double models_s = 0.0, runs_s = 0.0, probes_s = 0.0, twins_s = 0.0, setup_s = 0.0, extra_s = 0.0;
+  void add(const RunRecord& r) {
+    for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
+    probes_s += r.probe_s;
+    twins_s += r.twin_s;
+    setup_s += r.setup_s;
+    extra_s += r.settle_extra_s;
+  }
+  void print(const GroomTimes& groom) const {
+    std::printf("time: load %.3f s (read, repairs, follow hairs), fit %.3f s (unit, head sphere, collider), "
+                "model steps %.3f s, the models' probes %.3f s, rest twins %.3f s, setup %.3f s and steps past the "
+                "end %.3f s, metrics and the rest %.3f s\n",
+                groom.load_s, groom.fit_s, models_s, probes_s, twins_s, setup_s, extra_s,
+                runs_s - models_s - probes_s - twins_s - setup_s - extra_s);
+  }
+};
+
+int run_batches(CompareArgs& a, bool sweep) {
+  prepare_compare(a, sweep);
+  check_groom_args(a);
   GroomTimes groom_times;
   const std::vector<Scenario> scenarios = a.groom.empty() ? load_scenarios(a) : load_groom_scenarios(a, groom_times);
   if (!a.groom.empty())
@@ -423,7 +448,7 @@ int run_batches(CompareArgs& a, bool sweep) {
   int total = 0;
   for (const PlanItem& it : plan.items) total += it.shard == mine;
 
-  double models_s = 0.0, runs_s = 0.0, probes_s = 0.0, twins_s = 0.0, setup_s = 0.0, extra_s = 0.0;
+  TimeSplit time;
   ThreadPool pool(a.threads);
   Progress progress(total, true);
   std::vector<RunRecord> runs;
@@ -456,7 +481,7 @@ int run_batches(CompareArgs& a, bool sweep) {
       progress.begin(static_cast<int>(opt.models.size()), what);
       const auto start = std::chrono::steady_clock::now();
       std::vector<RunRecord> got = run_scenario(sc, opt, pool);
-      runs_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      time.runs_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       progress.end();
       // A deviation measures accuracy only against a reference that is ok.
       if (!got.empty() && got.front().reference_status != verdict::Status::ok)
@@ -464,23 +489,13 @@ int run_batches(CompareArgs& a, bool sweep) {
                     got.front().reference.c_str(), std::string(verdict::status_name(got.front().reference_status)).c_str());
       for (const RunRecord& r : got) {
         print_run(run_json(r));
-        for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
-        probes_s += r.probe_s;
-        twins_s += r.twin_s;
-        setup_s += r.setup_s;
-        extra_s += r.settle_extra_s;
+        time.add(r);
       }
       std::fflush(stdout);
       for (RunRecord& r : got) runs.push_back(std::move(r));
     }
   }
-  // Stepping the models is what a comparison measures; the rest is overhead.
-  if (!a.groom.empty())
-    std::printf("time: load %.3f s (read, repairs, follow hairs), fit %.3f s (unit, head sphere, collider), "
-                "model steps %.3f s, the models' probes %.3f s, rest twins %.3f s, setup %.3f s and steps past the "
-                "end %.3f s, metrics and the rest %.3f s\n",
-                groom_times.load_s, groom_times.fit_s, models_s, probes_s, twins_s, setup_s, extra_s,
-                runs_s - models_s - probes_s - twins_s - setup_s - extra_s);
+  if (!a.groom.empty()) time.print(groom_times);
   nlohmann::json sweep_json;
   if (a.knob) sweep_json = {{"knob", knob_name}, {"values", values}, {"models", a.run.models}};
   return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan);
@@ -822,7 +837,7 @@ void add_stress_options(CLI::App& sub, StressArgs& a) {
 }
 
 void add_reproduce_options(CLI::App& sub, std::vector<std::string>& tables, ReproduceOptions& o, ReproduceShard& rs) {
-  sub.add_option("TABLE", tables, "han2012, halen2007, plante2001 or all; several may be named")
+  sub.add_option("TABLE", tables, reproduce_paper_names() + " or all; several may be named")
       ->type_name("NAME");
   sub.add_option("--frames", o.frames, "cap every run at N frames (quick runs), 1 to 1000000")
       ->type_name("N")
@@ -863,6 +878,15 @@ InputError argument_error(const CLI::App& top, const CLI::ParseError& e) {
   if (dynamic_cast<const CLI::RequiredError*>(&e) && sub != &top)
     return InputError("arguments", sub->get_name(), msg + " (see " + help + ")");
   return InputError("arguments: " + msg);
+}
+
+// --plugin, the same for every subcommand that lists or runs models.
+void add_plugin_option(CLI::App& sub, std::vector<std::string>& paths) {
+  sub.add_option("--plugin", paths,
+                 "load models from a plugin library (docs/plugins.md), after\nthe default ones and "
+                 "HAIRBENCH_PLUGIN_PATH's; repeatable")
+      ->type_name("PATH.so")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }
 
 int run(int argc, char** argv) {
@@ -913,12 +937,7 @@ int run(int argc, char** argv) {
   CLI::App* reproduce = app.add_subcommand("reproduce", kReproduceHelp);
   add_reproduce_options(*reproduce, tables, reproduce_opt, reproduce_shard);
 
-  for (CLI::App* sub : {list, compare, sweep, stress})
-    sub->add_option("--plugin", plugin_paths,
-                    "load models from a plugin library (docs/plugins.md), after\nthe default ones and "
-                    "HAIRBENCH_PLUGIN_PATH's; repeatable")
-        ->type_name("PATH.so")
-        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  for (CLI::App* sub : {list, compare, sweep, stress}) add_plugin_option(*sub, plugin_paths);
 
   // Without arguments the usage is the answer, with the exit code of a bad command line;
   // `hairbench help` is a documented spelling of --help.

@@ -2,7 +2,7 @@
 
 #include "core/parallel.h"
 #include "harness/runner.h"
-#include "models/plante2001/fused/model.h"
+#include "models/plante2001/fused/wisp_fused.h"
 #include "models/plante2001/settings.h"
 #include "scenarios/groom_gen.h"
 

@@ -40,6 +40,68 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The pulse: a rotation about a fixed, oblique axis through the head centre, of the angle
+// that moves a point at the farthest root plus one strand length by `amplitude` strand
+// lengths.
+Affine3f pulse_of(const Groom& groom, double mean_length, double amplitude) {
+  double reach = 0.0;
+  for (std::size_t s = 0; s < groom.strand_count(); ++s)
+    reach = std::max(reach, static_cast<double>(groom.positions[groom.strand_begin(s)].head<3>().norm()));
+  reach += mean_length;
+  const Vec3f axis = Vec3f(1.0f, 2.0f, 3.0f).normalized();
+  return Affine3f(Eigen::AngleAxisf(static_cast<float>(amplitude * mean_length / reach), axis));
+}
+
+// Each strand's displacement projected on its first one after the pulse: a signed signal
+// per strand that holds every mode the pulse excited in it.
+void project_on_first(const Groom& groom, std::span<const Vec4f> p, std::span<const Vec4f> q,
+                      std::vector<Vec4f>& first, std::vector<std::vector<double>>& x) {
+  if (first.empty())
+    for (std::size_t v = 0; v < p.size(); ++v) first.push_back(p[v] - q[v]);
+  for (std::size_t s = 0; s < groom.strand_count(); ++s) {
+    double dot = 0.0;
+    for (std::uint32_t v = groom.strand_begin(s); v < groom.strand_begin(s + 1); ++v)
+      dot += static_cast<double>((p[v] - q[v]).head<3>().dot(first[v].head<3>()));
+    x[s].push_back(dot);
+  }
+}
+
+// Each strand's slowest mode (strands of different lengths and regions swing at their own
+// rates), and the median over the strands of each of sigma and omega.
+void card_mode(const std::vector<std::vector<double>>& x, double dt, material::Card& card) {
+  std::vector<double> sigma, omega;
+  for (const std::vector<double>& xs : x) {
+    const material::Mode mode = material::slowest_mode(xs, dt, ProbeSettings::kCardSkipFrames);
+    if (!std::isfinite(mode.sigma)) continue;
+    sigma.push_back(mode.sigma);
+    omega.push_back(mode.omega);
+  }
+  card.sigma = median(sigma);
+  card.omega = median(omega);
+}
+
+// The probe's verdict from the kicked copy's distances from the still one, frame by frame.
+verdict::Probe probe_of(const std::vector<double>& d, double dt) {
+  using S = ProbeSettings;
+  auto mean = [](const double* v, int n) {
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += v[i];
+    return s / n;
+  };
+  verdict::Probe probe;
+  probe.run = true;
+  probe.kick = d.front();
+  probe.first = mean(d.data() + 1, S::kWindow);
+  probe.last = mean(d.data() + d.size() - S::kWindow, S::kWindow);
+  // From the kick itself, not the first window: where a rest edge is rounding-sized, the
+  // kick turns it at once and the first frames after it already hold most of the growth.
+  const double span = (static_cast<double>(d.size()) - 0.5 * (S::kWindow + 1)) * dt;
+  probe.rate = std::log(probe.last / probe.kick) / span;
+  // NaN (a kicked copy that blew up) counts as growth.
+  probe.grows = !(probe.rate <= S::kMinGrowthRate) && !(probe.last <= S::kMinGrowth * S::kAmplitude);
+  return probe;
+}
+
 }  // namespace
 
 AtRest probe_at_rest(const ModelInfo& info, const Scenario& sc, const ParamSet& params, ThreadPool& pool,
@@ -62,17 +124,9 @@ AtRest probe_at_rest(const ModelInfo& info, const Scenario& sc, const ParamSet& 
   if (kicked) kicked->reset(groom, params);
   if (carded) carded->reset(groom, params);
 
-  // The pulse: a rotation about a fixed, oblique axis through the head centre, of the
-  // angle that moves a point at the farthest root plus one strand length by kAmplitude
-  // strand lengths (the card's by kCardAmplitude).
   const double mean_length = mean_strand_length(groom);
-  double reach = 0.0;
-  for (std::size_t s = 0; s < groom.strand_count(); ++s)
-    reach = std::max(reach, static_cast<double>(groom.positions[groom.strand_begin(s)].head<3>().norm()));
-  reach += mean_length;
-  const Vec3f axis = Vec3f(1.0f, 2.0f, 3.0f).normalized();
-  const Affine3f pulse(Eigen::AngleAxisf(static_cast<float>(S::kAmplitude * mean_length / reach), axis));
-  const Affine3f card_pulse(Eigen::AngleAxisf(static_cast<float>(S::kCardAmplitude * mean_length / reach), axis));
+  const Affine3f pulse = pulse_of(groom, mean_length, S::kAmplitude);
+  const Affine3f card_pulse = pulse_of(groom, mean_length, S::kCardAmplitude);
 
   FrameInput in;
   in.dt = sc.dt;
@@ -104,51 +158,10 @@ AtRest probe_at_rest(const ModelInfo& info, const Scenario& sc, const ParamSet& 
     if (k == 1) kick.head_prev = card_pulse;
     carded->step(kick, times);
     times.clear();
-    if (k >= 1) {
-      // Each strand's displacement projected on its first one after the pulse: a signed
-      // signal per strand that holds every mode the pulse excited in it.
-      const auto p = carded->positions(), q = still->positions();
-      if (first.empty())
-        for (std::size_t v = 0; v < p.size(); ++v) first.push_back(p[v] - q[v]);
-      for (std::size_t s = 0; s < groom.strand_count(); ++s) {
-        double dot = 0.0;
-        for (std::uint32_t v = groom.strand_begin(s); v < groom.strand_begin(s + 1); ++v)
-          dot += static_cast<double>((p[v] - q[v]).head<3>().dot(first[v].head<3>()));
-        x[s].push_back(dot);
-      }
-    }
+    if (k >= 1) project_on_first(groom, carded->positions(), still->positions(), first, x);
   }
-  if (carded) {
-    // Each strand's slowest mode (strands of different lengths and regions swing at
-    // their own rates), and the median over the strands of each of sigma and omega.
-    std::vector<double> sigma, omega;
-    for (const std::vector<double>& xs : x) {
-      const material::Mode mode = material::slowest_mode(xs, sc.dt, S::kCardSkipFrames);
-      if (!std::isfinite(mode.sigma)) continue;
-      sigma.push_back(mode.sigma);
-      omega.push_back(mode.omega);
-    }
-    out.card.sigma = median(sigma);
-    out.card.omega = median(omega);
-  }
-  if (!kicked) return out;
-
-  auto mean = [](const double* v, int n) {
-    double s = 0.0;
-    for (int i = 0; i < n; ++i) s += v[i];
-    return s / n;
-  };
-  verdict::Probe& probe = out.probe;
-  probe.run = true;
-  probe.kick = d.front();
-  probe.first = mean(d.data() + 1, S::kWindow);
-  probe.last = mean(d.data() + d.size() - S::kWindow, S::kWindow);
-  // From the kick itself, not the first window: where a rest edge is rounding-sized, the
-  // kick turns it at once and the first frames after it already hold most of the growth.
-  const double span = (static_cast<double>(d.size()) - 0.5 * (S::kWindow + 1)) * sc.dt;
-  probe.rate = std::log(probe.last / probe.kick) / span;
-  // NaN (a kicked copy that blew up) counts as growth.
-  probe.grows = !(probe.rate <= S::kMinGrowthRate) && !(probe.last <= S::kMinGrowth * S::kAmplitude);
+  if (carded) card_mode(x, sc.dt, out.card);
+  if (kicked) out.probe = probe_of(d, sc.dt);
   return out;
 }
 

@@ -14,10 +14,12 @@
 
 namespace hairbench {
 
-inline constexpr const char* kReproducePapers[] = {"han2012", "halen2007", "plante2001"};
+// The papers `reproduce` runs, in the report's order, as the command line names them:
+// "han2012, halen2007, plante2001" (the one list, in harness/reproduce/reproduce.cpp).
+std::string reproduce_paper_names();
 
 struct ReproduceOptions {
-  std::vector<std::string> papers;  // in kReproducePapers order
+  std::vector<std::string> papers;  // in reproduce_paper_names' order
   int frames = 0;                   // > 0: every run stops after this many frames (quick runs)
   int threads = 0;                  // 0: every hardware thread
   std::string device;               // Vulkan device for Han & Harada's GPU table
@@ -32,8 +34,8 @@ struct ReproduceOptions {
 // shards run with different caps are of different plans and never merged.
 std::string reproduce_plan_key(const std::string& paper, const nlohmann::json& frames_cap);
 
-// The tables named on the command line (each of kReproducePapers or "all") as
-// ReproduceOptions::papers, in kReproducePapers order; throws InputError naming a bad one.
+// The tables named on the command line (each of reproduce_paper_names or "all") as
+// ReproduceOptions::papers, in that order; throws InputError naming a bad one.
 std::vector<std::string> select_papers(const std::vector<std::string>& names);
 
 // Runs the selected papers; `log` gets one line per configuration as it starts.

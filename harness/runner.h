@@ -123,12 +123,6 @@ std::vector<double> back_to_back_gpu_ms(HairModel& model, const Scenario& sc, in
 inline constexpr const char* kConvergedReference = "converged";
 std::vector<ParamOverride> converged_overrides(const ModelInfo& model);
 
-// The resolved scenario as a hash (16 hex digits): the loaded groom's bits, the head
-// script's keys and oscillators, the colliders, wind, gravity, time step, the first
-// `frames` frames, the settle time, the reference and every parameter override the file
-// gives. Shards of one sweep must agree on it (hairbench merge); the script is hashed as
-// written, not evaluated, so that the hash does not depend on a machine's libm.
-std::string scenario_hash(const Scenario& sc, int frames);
 
 // The groom strands the strand pictures show: every k-th strand, at most
 // kMaxSnapshotStrands of them.

@@ -309,13 +309,4 @@ std::string plan_hash(const Plan& plan) {
   return b;
 }
 
-Fnv64& Fnv64::bytes(const void* p, std::size_t n) {
-  const auto* c = static_cast<const unsigned char*>(p);
-  for (std::size_t i = 0; i < n; ++i) {
-    h_ ^= c[i];
-    h_ *= 0x100000001b3ull;
-  }
-  return *this;
-}
-
 }  // namespace hairbench

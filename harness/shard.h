@@ -4,6 +4,8 @@
 // every shard of one command agrees on the cut without talking to the others.
 #pragma once
 
+#include "core/fnv64.h"
+
 #include "core/params.h"
 #include "models/registry.h"
 #include "scenarios/scenario.h"
@@ -123,23 +125,5 @@ nlohmann::json shard_json(const Plan& plan, const ShardSpec& shard);
 // "0123456789abcdef": a hash of the plan's keys and their shards; shards of one command
 // carry the same.
 std::string plan_hash(const Plan& plan);
-
-// FNV-1a, 64 bit, over bytes fed in order: scenario definitions and plans.
-class Fnv64 {
- public:
-  Fnv64& bytes(const void* p, std::size_t n);
-  template <class T>
-  Fnv64& value(const T& v) {
-    return bytes(&v, sizeof v);
-  }
-  Fnv64& text(const std::string& s) {
-    value(s.size());
-    return bytes(s.data(), s.size());
-  }
-  std::uint64_t digest() const { return h_; }
-
- private:
-  std::uint64_t h_ = 0xcbf29ce484222325ull;
-};
 
 }  // namespace hairbench

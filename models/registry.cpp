@@ -3,20 +3,20 @@
 #include "core/error.h"
 #include "models/halen2007/cascade_settings.h"
 #include "models/halen2007/forest_settings.h"
-#include "models/halen2007/fused/model.h"
+#include "models/halen2007/fused/halen_fused.h"
 #include "models/halen2007/nodes_model.h"
 #include "models/halen2007/reference/cascade.h"
 #include "models/halen2007/reference/forest.h"
 #include "models/halen2007/reference/spring.h"
 #include "models/halen2007/spring_settings.h"
-#include "models/han2012/fused/model.h"
-#include "models/han2012/reference/model.h"
+#include "models/han2012/fused/han_fused.h"
+#include "models/han2012/reference/han_reference.h"
 #include "models/han2012/settings.h"
-#include "models/plante2001/fused/model.h"
-#include "models/plante2001/reference/model.h"
+#include "models/plante2001/fused/wisp_fused.h"
+#include "models/plante2001/reference/wisp_reference.h"
 #include "models/plante2001/settings.h"
 #ifdef HAIRBENCH_HAS_VULKAN
-#include "models/han2012/vulkan/model.h"
+#include "models/han2012/vulkan/han_vulkan.h"
 #endif
 
 #include <iterator>

@@ -132,7 +132,7 @@ struct ScenarioRecord {
   // the reference itself, and hairbench merge checks that they all got the same bits.
   std::uint64_t reference_state_hash = 0;
   // The resolved scenario with the command's --set, --frames and reference
-  // (harness/runner.h, scenario_hash), 16 hex digits.
+  // (scenarios/scenario.h, scenario_hash), 16 hex digits.
   std::string definition_hash;
 };
 

@@ -109,4 +109,11 @@ std::vector<Scenario> load_builtin_scenarios();
 // A name ("shake") or a path to a JSON file -> the file; InputError if neither exists.
 std::filesystem::path find_scenario(const std::string& name_or_path);
 
+// The resolved scenario as a hash (16 hex digits): the loaded groom's bits, the head
+// script's keys and oscillators, the colliders, wind, gravity, time step, the first
+// `frames` frames, the settle time, the reference and every parameter override the file
+// gives. Shards of one sweep must agree on it (hairbench merge); the script is hashed as
+// written, not evaluated, so that the hash does not depend on a machine's libm.
+std::string scenario_hash(const Scenario& sc, int frames);
+
 }  // namespace hairbench

@@ -7,7 +7,7 @@
 #include "core/parallel.h"
 #include "kernels/halen2007/fused/halen_soa.h"
 #include "kernels/simd/vec_math.h"
-#include "models/halen2007/fused/model.h"
+#include "models/halen2007/fused/halen_fused.h"
 #include "models/registry.h"
 #include "reports/metrics.h"
 

@@ -7,8 +7,8 @@
 #include "core/parallel.h"
 #include "kernels/simd/isa.h"
 #include "kernels/han2012/fused/han_soa.h"
-#include "models/han2012/reference/model.h"
-#include "models/han2012/fused/model.h"
+#include "models/han2012/reference/han_reference.h"
+#include "models/han2012/fused/han_fused.h"
 #include "models/registry.h"
 #include "reports/metrics.h"
 

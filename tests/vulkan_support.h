@@ -4,7 +4,7 @@
 
 #include "core/parallel.h"
 #include "harness/runner.h"
-#include "models/han2012/vulkan/model.h"
+#include "models/han2012/vulkan/han_vulkan.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -10,7 +10,7 @@
 #include "device_metrics_support.h"
 #include "harness/gpu_clock.h"
 #include "kernels/vulkan/runtime.h"
-#include "models/han2012/vulkan/model.h"
+#include "models/han2012/vulkan/han_vulkan.h"
 #include "scenarios/tfx/tfx.h"
 #include "vulkan_support.h"
 

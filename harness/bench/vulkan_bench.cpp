@@ -6,7 +6,7 @@
 #include "core/parallel.h"
 #include "harness/gpu_clock.h"
 #include "harness/runner.h"
-#include "models/han2012/vulkan/model.h"
+#include "models/han2012/vulkan/han_vulkan.h"
 #include "reports/report.h"
 #include "scenarios/scenario.h"
 

@@ -12,7 +12,7 @@
 #include "kernels/simd/isa.h"
 #include "kernels/plante2001/wisp_grid.h"
 #include "kernels/plante2001/fused/wisp_soa.h"
-#include "models/plante2001/fused/model.h"
+#include "models/plante2001/fused/wisp_fused.h"
 #include "models/registry.h"
 #include "scenarios/scenario.h"
 

@@ -1,5 +1,6 @@
 // The driver of `hairbench reproduce`: runs the selected papers (one file each in this
-// folder), counts the three kinds of rows apart, writes the report, its charts and pages.
+// folder, each a table of its claims over a context it builds once, rows.h), counts the
+// three kinds of rows apart, writes the report, its charts and pages.
 #include "harness/reproduce.h"
 
 #include "core/error.h"
@@ -14,12 +15,31 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <string_view>
 
 namespace hairbench {
 
 using nlohmann::json;
 
 namespace {
+
+// The papers, in the report's order: the one list, which the command line's names (and
+// so the shard split, over ReproduceOptions::papers), the help and the driver read.
+struct Paper {
+  std::string_view name;                                // on the command line and as papers[].id
+  std::string_view title;                               // in the progress log
+  reproduce::PaperResult (*run)(const reproduce::Ctx&);  // its context, then its claims (rows.h)
+};
+constexpr Paper kPapers[] = {
+    {"han2012", "Han & Harada 2012", reproduce::reproduce_han},
+    {"halen2007", "Halén & Wester 2007", reproduce::reproduce_halen},
+    {"plante2001", "Plante, Cani & Poulin 2001", reproduce::reproduce_plante},
+};
+
+const Paper* find_paper(std::string_view name) {
+  const auto it = std::ranges::find(kPapers, name, &Paper::name);
+  return it == std::end(kPapers) ? nullptr : it;
+}
 
 json load_average() {
   std::ifstream in("/proc/loadavg");
@@ -49,15 +69,22 @@ std::string reproduce_plan_key(const std::string& paper, const json& frames_cap)
   return frames_cap.is_null() ? paper : paper + " --frames " + frames_cap.dump();
 }
 
+std::string reproduce_paper_names() {
+  std::string s;
+  for (const Paper& p : kPapers) s += (s.empty() ? "" : ", ") + std::string(p.name);
+  return s;
+}
+
 std::vector<std::string> select_papers(const std::vector<std::string>& names) {
-  auto named = [&](const std::string& p) { return std::find(names.begin(), names.end(), p) != names.end(); };
+  auto named = [&](std::string_view p) { return std::find(names.begin(), names.end(), p) != names.end(); };
   for (const std::string& n : names)
-    if (n != "all" && std::ranges::find(kReproducePapers, n) == std::end(kReproducePapers))
-      throw InputError("arguments", "reproduce " + n, "expected han2012, halen2007, plante2001 or all");
-  if (names.empty()) throw InputError("arguments", "reproduce", "name a table: han2012, halen2007, plante2001 or all");
+    if (n != "all" && !find_paper(n))
+      throw InputError("arguments", "reproduce " + n, "expected " + reproduce_paper_names() + " or all");
+  if (names.empty())
+    throw InputError("arguments", "reproduce", "name a table: " + reproduce_paper_names() + " or all");
   std::vector<std::string> papers;
-  for (const char* p : kReproducePapers)
-    if (named(p) || named("all")) papers.emplace_back(p);
+  for (const Paper& p : kPapers)
+    if (named(p.name) || named("all")) papers.emplace_back(p.name);
   return papers;
 }
 
@@ -69,10 +96,11 @@ json run_reproduce(const ReproduceOptions& opt, const std::function<void(const s
   report["context"] = make_report(ReportContext{pool.threads(), {}}, {})["context"];
   const json load_start = load_average();
   json papers = json::array();
-  for (const std::string& p : opt.papers) {
-    if (p == "han2012") papers.push_back(reproduce::to_json(reproduce::reproduce_han(c)));
-    else if (p == "halen2007") papers.push_back(reproduce::to_json(reproduce::reproduce_halen(c)));
-    else papers.push_back(reproduce::to_json(reproduce::reproduce_plante(c)));
+  for (const std::string& name : opt.papers) {
+    const Paper* p = find_paper(name);
+    if (!p) throw InputError("arguments", "reproduce " + name, "expected " + reproduce_paper_names() + " or all");
+    log(name + ": " + std::string(p->title));
+    papers.push_back(reproduce::to_json(p->run(c)));
   }
   report["papers"] = papers;
   report["frames_cap"] = opt.frames > 0 ? json(opt.frames) : json(nullptr);

@@ -22,6 +22,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace hairbench::reproduce {
@@ -127,6 +128,32 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 // Short number formatting for reasons and tables ("-" for NaN).
 std::string num(double v);
 
+// One thing a paper says that the report checks, and the function that checks it: it
+// adds that statement's rows (setup, claim or measurement rows) to the paper's result.
+// `Shared` is the paper's context, what several of its claims use, built once.
+template <class Shared>
+struct Claim {
+  std::string_view id;       // the rows' ids as reproduce.json writes them; a{b,c} is ab and ac
+  std::string_view section;  // where in the paper
+  std::string_view quote;    // the paper's words being checked (or, where it has none, the rows' subject)
+  void (*check)(const Shared& shared, PaperResult& out);
+};
+
+// A paper's rows: its context built once (a `Shared` holds the published file as `pub`),
+// then each of its claims in the table's order, which is the report's.
+template <class Shared, std::size_t N>
+PaperResult check_claims(const Ctx& c, const std::string& paper, const Claim<Shared> (&claims)[N]) {
+  const Shared shared(c);
+  PaperResult out{paper, shared.pub["paper"]};
+  for (const Claim<Shared>& claim : claims) {
+    c.log(out.id + " " + std::string(claim.id) + " (" + std::string(claim.section) + ")");
+    claim.check(shared, out);
+  }
+  return out;
+}
+
+// Each paper's rows (its file in this folder): its context, then its claims. The driver's
+// table of papers (reproduce.cpp) names them.
 PaperResult reproduce_han(const Ctx& c);
 PaperResult reproduce_halen(const Ctx& c);
 PaperResult reproduce_plante(const Ctx& c);

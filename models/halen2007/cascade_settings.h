@@ -17,14 +17,17 @@
 #pragma once
 
 #include "core/params.h"
+#include "models/halen2007/spring_region.h"
 
 #include <array>
+#include <cstddef>
+#include <vector>
 
 namespace hairbench::halen_cascade {
 
 inline constexpr std::array<ParamSpec, 10> kParams{{
     {"nodes", 8, 2, 64, true,
-     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; stiffness is given at 8 nodes and scales as ((nodes - 1) / 7)^3.6"},
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; stiffness is given at 8 nodes and scales as ((nodes - 1) / 7)^3.6", ParamRole::cost_knob},
     {"damping", 0.03, 0.0, 1.0, false,
      "fraction of velocity removed per sixth of a frame in Verlet (Eq. 4.1: k = 1 - damping), taken per "
      "substep as the same per frame at any substep count", ParamRole::damping},
@@ -35,8 +38,8 @@ inline constexpr std::array<ParamSpec, 10> kParams{{
      "c of §5.9, 1/m: the strength is k up to L = 1/c from the root, then falls as (L c)^-a"},
     {"down_fraction", 0.25, 0.0, 1.0, false,
      "downward reference springs' strength as a fraction of the upward ones (§5.9; 1 = equal)"},
-    {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep"},
-    {"substeps", 6, 1, 1024, true, "solver passes per frame; the head is interpolated between them"},
+    {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep", ParamRole::cost_knob},
+    {"substeps", 6, 1, 1024, true, "solver passes per frame; the head is interpolated between them", ParamRole::cost_knob},
     {"reactions", 1, 0, 1, true,
      "1: each reference spring pushes back on the segment that carries its space (the torsion spring "
      "§4.3 says the reference nodes simulate); 0: the reference nodes are fixed during the step"},
@@ -44,5 +47,24 @@ inline constexpr std::array<ParamSpec, 10> kParams{{
      "how a tangent space takes B and T from its parent's: 0 the thesis's B = N x T_parent (§4.3), "
      "1 parallel transport (the parent's space turned with the segment)"},
 }};
+
+// kParams read once from a ParamSet, per region where the parameter may differ by region:
+// the reference (reference/cascade.cpp) and the fused kernel (fused/halen_fused.cpp) both
+// take their settings from here.
+struct RegionSettings : halen::SpringRegion {
+  float down_fraction;  // the downward reference springs' strength over the upward ones (§5.9)
+};
+struct Settings {
+  std::vector<RegionSettings> regions;
+  int substeps;
+  int frames;      // kernels::CascadeFrames
+  bool reactions;  // the springs' reactions through the spaces (§4.3)
+};
+inline Settings read_settings(const ParamSet& p, std::size_t region_count) {
+  Settings s{{}, p.get_int("substeps"), p.get_int("frames"), p.get_int("reactions") != 0};
+  for (std::size_t r = 0; r < region_count; ++r)
+    s.regions.push_back({halen::read_spring_region(p, r), static_cast<float>(p.get("down_fraction", r))});
+  return s;
+}
 
 }  // namespace hairbench::halen_cascade

@@ -42,12 +42,14 @@
 #include "core/params.h"
 
 #include <array>
+#include <cstddef>
+#include <vector>
 
 namespace hairbench::halen_forest {
 
 inline constexpr std::array<ParamSpec, 14> kParams{{
     {"nodes", 8, 2, 64, true,
-     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2"},
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2", ParamRole::cost_knob},
     {"joint_stiffness", 1100.0, 0.0, 1e6, false,
      "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2", ParamRole::stiffness},
     {"joint_damping", 26.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},
@@ -62,7 +64,7 @@ inline constexpr std::array<ParamSpec, 14> kParams{{
     {"collision_damping", 1.0, 0.0, 1.5, false,
      "ζ: the penalty force is damped along the sphere's normal at ζ times critical for it, 2ζ √(collision_stiffness) / dt; "
      "held within that rate times depth / dt; 0 a spring only"},
-    {"substeps", 12, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
+    {"substeps", 12, 1, 64, true, "solver passes per frame; the head is interpolated between them", ParamRole::cost_knob},
     {"gravity_compensation", 1, 0, 1, true,
      "1: gravity's torque on the head-transformed rest segment is subtracted, so that pose is in "
      "equilibrium; 0: §4.2 as written, gravity bends the strand until the joint springs hold it"},
@@ -81,5 +83,38 @@ inline constexpr std::array<ParamSpec, 14> kParams{{
      "raised until its joints hold it under twice its weight (kernels::forest_rest_inertia_scale); 0 J as "
      "given on every strand"},
 }};
+
+// kParams read once from a ParamSet, per region where the parameter may differ by region:
+// the reference (reference/forest.cpp) and the fused kernel (fused/halen_fused.cpp) both
+// take their settings from here.
+struct RegionSettings {
+  float joint_stiffness, joint_damping, falloff_scale, collision_stiffness, collision_damping, drag;
+  int falloff_exponent;
+};
+struct Settings {
+  std::vector<RegionSettings> regions;
+  int substeps;
+  bool parent_z_axes;              // axis_convention 0 (§4.2 as written)
+  bool mass_inertia;               // inertia 0: J = mI
+  bool gravity_compensation;
+  bool root_angular_acceleration;
+  bool rest_hold;                  // asked for; it applies with the strand-pendulum inertia only
+};
+inline Settings read_settings(const ParamSet& p, std::size_t region_count) {
+  Settings s{{},
+             p.get_int("substeps"),
+             p.get_int("axis_convention") == 0,
+             p.get_int("inertia") == 0,
+             p.get_int("gravity_compensation") != 0,
+             p.get_int("root_angular_acceleration") != 0,
+             p.get_int("rest_hold") != 0};
+  for (std::size_t r = 0; r < region_count; ++r)
+    s.regions.push_back({static_cast<float>(p.get("joint_stiffness", r)), static_cast<float>(p.get("joint_damping", r)),
+                         static_cast<float>(p.get("falloff_scale", r)),
+                         static_cast<float>(p.get("collision_stiffness", r)),
+                         static_cast<float>(p.get("collision_damping", r)), static_cast<float>(p.get("drag", r)),
+                         p.get_int("falloff_exponent", r)});
+  return s;
+}
 
 }  // namespace hairbench::halen_forest

@@ -12,14 +12,17 @@
 #pragma once
 
 #include "core/params.h"
+#include "models/halen2007/spring_region.h"
 
 #include <array>
+#include <cstddef>
+#include <vector>
 
 namespace hairbench::halen_spring {
 
 inline constexpr std::array<ParamSpec, 8> kParams{{
     {"nodes", 8, 2, 64, true,
-     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand"},
+     "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand", ParamRole::cost_knob},
     {"damping", 0.04, 0.0, 1.0, false,
      "fraction of velocity removed per sixth of a frame in Verlet (Eq. 4.1: k = 1 - damping), taken per "
      "substep as the same per frame at any substep count", ParamRole::damping},
@@ -31,8 +34,25 @@ inline constexpr std::array<ParamSpec, 8> kParams{{
     {"tilt_min", 0.3, 0.0, 1.0, false,
      "alpha/k of §4.4's k_m: the fraction of the strength kept with the head upside down; 1 turns "
      "the tilt weakening off"},
-    {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep"},
-    {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them"},
+    {"length_iterations", 6, 0, 64, true, "edge corrections (Eq. 4.2) per substep", ParamRole::cost_knob},
+    {"substeps", 6, 1, 64, true, "solver passes per frame; the head is interpolated between them", ParamRole::cost_knob},
 }};
+
+// kParams read once from a ParamSet, per region where the parameter may differ by region:
+// the reference (reference/spring.cpp) and the fused kernel (fused/halen_fused.cpp) both
+// take their settings from here.
+struct RegionSettings : halen::SpringRegion {
+  float tilt_min;  // §5.9's tilt weakening floor
+};
+struct Settings {
+  std::vector<RegionSettings> regions;
+  int substeps;
+};
+inline Settings read_settings(const ParamSet& p, std::size_t region_count) {
+  Settings s{{}, p.get_int("substeps")};
+  for (std::size_t r = 0; r < region_count; ++r)
+    s.regions.push_back({halen::read_spring_region(p, r), static_cast<float>(p.get("tilt_min", r))});
+  return s;
+}
 
 }  // namespace hairbench::halen_spring

@@ -51,7 +51,7 @@
 // of the stiffening compression spring, and strands that would otherwise fly apart,
 // kMinRadiusFraction and kMaxRadiusFraction in kernels/plante2001/reference/wisp_kernels.h); and the
 // skeleton's bend bounds, finer skeletons at folds and averaged axes on curls
-// (skeleton_of in model.cpp).
+// (skeleton_of in wisp_model.cpp).
 #pragma once
 
 #include "core/params.h"
@@ -78,7 +78,7 @@ inline constexpr std::array<ParamSpec, 27> kParams{{
      "smallest rest envelope radius, metres (a wisp of one strand has no spread of its own)"},
     {"root_blend", 3, 0, 64, true,
      "free nodes over which the strand rebuild turns from head-carried to section axes (ours; 0: the paper's layer)"},
-    {"integration_hz", 1000, 1, 100000, false, "explicit integration rate (§5.3: 1000 Hz)"},
+    {"integration_hz", 1000, 1, 100000, false, "explicit integration rate (§5.3: 1000 Hz)", ParamRole::cost_knob},
     {"collision_hz", 120, 0, 100000, false, "wisp-body collision detection rate (§5.3: 120 Hz); 0 off"},
     {"interaction_hz", 24, 0, 100000, false, "wisp-wisp interaction detection rate (§5.3: 24 Hz); 0 off"},
     {"air_drag", 5.0, 0, 1000, false, "air resistance on every mass, 1/s (§5.1 step 1)", ParamRole::damping},

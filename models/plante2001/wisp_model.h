@@ -21,8 +21,8 @@
 
 namespace hairbench::plante {
 
-// What the reference (reference/model.h, plante_wisp_ref) and the fused schedule
-// (fused/model.h, plante_wisp) share: the wisps built from the groom, the loop of §5.1 at
+// What the reference (reference/wisp_reference.h, plante_wisp_ref) and the fused schedule
+// (fused/wisp_fused.h, plante_wisp) share: the wisps built from the groom, the loop of §5.1 at
 // the rates of §5.3, the wisp-wisp detection's grid and chunks, and the strands' rebuild.
 // The two differ only in how a step visits the wisps (the hooks below); both run the same
 // kernels in the same order per wisp, so their results are bit-identical.

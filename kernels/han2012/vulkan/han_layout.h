@@ -4,7 +4,7 @@
 // valid in both languages (C++ gets GLSL-named stand-ins for uint, vec3, vec4 and mat4);
 // every member is 4 or 16 bytes, or a vec3 followed by a 4-byte member, and vec3/vec4/mat4
 // sit at 16-byte offsets, so std430 and the C++ layout agree byte for byte (checked by
-// static_asserts in models/han2012/vulkan/model.cpp).
+// static_asserts in models/han2012/vulkan/han_vulkan.cpp).
 #ifndef HAIRBENCH_KERNELS_VULKAN_HAN_LAYOUT_H
 #define HAIRBENCH_KERNELS_VULKAN_HAN_LAYOUT_H
 

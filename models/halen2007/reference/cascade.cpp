@@ -2,6 +2,7 @@
 
 #include "core/parallel.h"
 #include "kernels/common/strand_kernels.h"
+#include "models/halen2007/cascade_settings.h"
 
 namespace hairbench::halen_cascade {
 
@@ -14,14 +15,14 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   rest_length_ = rest_edge_lengths(rest);
   pos_ = rest.positions;
   step_.assign(rest.vertex_count(), Vec4f::Zero());
+  const halen_cascade::Settings settings = halen_cascade::read_settings(params, rest.region_names.size());
   region_.clear();
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r)
-    region_.push_back({static_cast<float>(params.get("damping", r)), params.get_int("length_iterations", r)});
-  substeps_ = params.get_int("substeps");
+  for (const halen_cascade::RegionSettings& r : settings.regions) region_.push_back({r.damping, r.length_iterations});
+  substeps_ = settings.substeps;
   sleep_.reset(rest.strand_count());
 
-  frames_ = static_cast<k::CascadeFrames>(params.get_int("frames"));
-  reactions_ = params.get_int("reactions") != 0;
+  frames_ = static_cast<k::CascadeFrames>(settings.frames);
+  reactions_ = settings.reactions;
   const std::size_t nv = rest.vertex_count();
   for (auto* v : {&inv_mass_, &k_up_, &k_down_, &lift_, &lever_}) v->resize(nv);
   base_.resize(nv);
@@ -29,10 +30,9 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   up_local_.resize(nv);
   down_local_.resize(nv);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t r = rest.strand_region[s];
-    k::cascade_setup(strand(rest_.positions, s), static_cast<float>(params.get("stiffness", r)),
-                     static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
-                     static_cast<float>(params.get("down_fraction", r)), frames_, strand(inv_mass_, s),
+    const halen_cascade::RegionSettings& r = settings.regions[rest.strand_region[s]];
+    k::cascade_setup(strand(rest_.positions, s), r.stiffness, r.falloff_scale, r.falloff_exponent, r.down_fraction,
+                     frames_, strand(inv_mass_, s),
                      strand(k_up_, s), strand(k_down_, s), strand(lift_, s), strand(base_, s), strand(lever_, s),
                      strand(rest_space_, s), strand(up_local_, s), strand(down_local_, s));
   }

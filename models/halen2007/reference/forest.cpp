@@ -1,6 +1,7 @@
 #include "models/halen2007/reference/forest.h"
 
 #include "core/parallel.h"
+#include "models/halen2007/forest_settings.h"
 
 #include <cmath>
 
@@ -12,21 +13,22 @@ ForestModel::ForestModel(const ModelContext& ctx) : ctx_(ctx) {}
 
 void ForestModel::reset(const Groom& rest, const ParamSet& params) {
   rest_ = rest;
-  axes_ = params.get_int("axis_convention") == 0 ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
-  substeps_ = params.get_int("substeps");
-  inertia_ = params.get_int("inertia") == 0 ? k::ForestInertia::Mass : k::ForestInertia::StrandPendulum;
-  gravity_compensation_ = params.get_int("gravity_compensation") != 0;
-  root_angular_acceleration_ = params.get_int("root_angular_acceleration") != 0;
-  rest_hold_ = inertia_ == k::ForestInertia::StrandPendulum && params.get_int("rest_hold") != 0;
+  const halen_forest::Settings settings = halen_forest::read_settings(params, rest.region_names.size());
+  axes_ = settings.parent_z_axes ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
+  substeps_ = settings.substeps;
+  inertia_ = settings.mass_inertia ? k::ForestInertia::Mass : k::ForestInertia::StrandPendulum;
+  gravity_compensation_ = settings.gravity_compensation;
+  root_angular_acceleration_ = settings.root_angular_acceleration;
+  rest_hold_ = inertia_ == k::ForestInertia::StrandPendulum && settings.rest_hold;
   joint_damping_.clear();
   drag_.clear();
   collision_stiffness_.clear();
   collision_damping_.clear();
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
-    joint_damping_.push_back(static_cast<float>(params.get("joint_damping", r)));
-    drag_.push_back(static_cast<float>(params.get("drag", r)));
-    collision_stiffness_.push_back(static_cast<float>(params.get("collision_stiffness", r)));
-    collision_damping_.push_back(static_cast<float>(params.get("collision_damping", r)));
+  for (const halen_forest::RegionSettings& r : settings.regions) {
+    joint_damping_.push_back(r.joint_damping);
+    drag_.push_back(r.drag);
+    collision_stiffness_.push_back(r.collision_stiffness);
+    collision_damping_.push_back(r.collision_damping);
   }
 
   const std::size_t nv = rest.vertex_count();
@@ -37,10 +39,10 @@ void ForestModel::reset(const Groom& rest, const ParamSet& params) {
   k_.assign(nv, 0.0f);
   inv_strand_length_.assign(rest.strand_count(), 0.0f);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
+    const halen_forest::RegionSettings& r = settings.regions[rest.strand_region[s]];
     inv_strand_length_[s] = k::forest_setup(
-        std::span(rest.positions).subspan(b, n), axes_, static_cast<float>(params.get("joint_stiffness", r)),
-        static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
+        std::span(rest.positions).subspan(b, n), axes_, r.joint_stiffness, r.falloff_scale, r.falloff_exponent,
         std::span(rest_frame_).subspan(b, n), std::span(theta0_).subspan(b, n), std::span(phi0_).subspan(b, n),
         std::span(length_).subspan(b, n), std::span(k_).subspan(b, n));
   }

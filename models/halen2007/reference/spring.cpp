@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "kernels/halen2007/reference/halen_kernels.h"
 #include "kernels/common/strand_kernels.h"
+#include "models/halen2007/spring_settings.h"
 
 namespace hairbench::halen_spring {
 
@@ -15,19 +16,19 @@ void SpringModel::reset(const Groom& rest, const ParamSet& params) {
   rest_length_ = rest_edge_lengths(rest);
   pos_ = rest.positions;
   prev_ = rest.positions;
+  const halen_spring::Settings settings = halen_spring::read_settings(params, rest.region_names.size());
   region_.clear();
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r)
-    region_.push_back({static_cast<float>(params.get("damping", r)), static_cast<float>(params.get("tilt_min", r)),
-                       params.get_int("length_iterations", r)});
-  substeps_ = params.get_int("substeps");
+  for (const halen_spring::RegionSettings& r : settings.regions)
+    region_.push_back({r.damping, r.tilt_min, r.length_iterations});
+  substeps_ = settings.substeps;
   sleep_.reset(rest.strand_count());
 
   k_.resize(rest.vertex_count());
   lift_.resize(rest.vertex_count());
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
-    k::spring_setup(std::span(rest.positions).subspan(b, n), static_cast<float>(params.get("stiffness", r)),
-                    static_cast<float>(params.get("falloff_scale", r)), params.get_int("falloff_exponent", r),
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
+    const halen_spring::RegionSettings& r = settings.regions[rest.strand_region[s]];
+    k::spring_setup(std::span(rest.positions).subspan(b, n), r.stiffness, r.falloff_scale, r.falloff_exponent,
                     std::span(k_).subspan(b, n), std::span(lift_).subspan(b, n));
   }
   ref_local_.resize(rest.vertex_count());

@@ -1,4 +1,6 @@
-#include "models/han2012/vulkan/model.h"
+#include "models/han2012/vulkan/han_vulkan.h"
+
+#include "models/han2012/settings.h"
 
 #include "core/error.h"
 #include "kernels/common/strand_kernels.h"
@@ -178,27 +180,28 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
 
   std::vector<L::HanRegion> regions;
   max_iterations_ = 0;
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
+  const han::Settings settings = han::read_settings(params, rest.region_names.size());
+  for (std::size_t r = 0; r < settings.regions.size(); ++r) {
+    const han::RegionSettings& given = settings.regions[r];
     // The method is a specialization constant of the one pipeline, so every region
     // runs the model's own method; a region asking for another is refused, not ignored.
-    const int method = params.get_int("method", r);
-    if (method != 0 && method != static_cast<int>(method_))
+    if (given.method != 0 && given.method != static_cast<int>(method_))
       throw InputError("regions." + rest.region_names[r], "method",
-                       std::to_string(method) + " differs from this model's method " +
+                       std::to_string(given.method) + " differs from this model's method " +
                            std::to_string(static_cast<int>(method_)) +
                            "; per-region methods run on the CPU models only");
     L::HanRegion g{};
-    g.damping = static_cast<float>(params.get("damping", r));
-    g.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
-    g.global_range = static_cast<float>(params.get("global_range", r));
-    g.global_ramp = params.get_int("global_ramp", r) != 0 ? 1u : 0u;
-    g.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
-    g.local_iterations = static_cast<std::uint32_t>(params.get_int("local_iterations", r));
-    g.length_iterations = static_cast<std::uint32_t>(params.get_int("length_iterations", r));
+    g.damping = given.damping;
+    g.global_stiffness = given.global_stiffness;
+    g.global_range = given.global_range;
+    g.global_ramp = given.global_ramp ? 1u : 0u;
+    g.local_stiffness = given.local_stiffness;
+    g.local_iterations = static_cast<std::uint32_t>(given.local_iterations);
+    g.length_iterations = static_cast<std::uint32_t>(given.length_iterations);
     max_iterations_ = std::max({max_iterations_, g.local_iterations, g.length_iterations});
     regions.push_back(g);
   }
-  substeps_ = params.get_int("substeps");
+  substeps_ = settings.substeps;
 
   // The kernels and the readback hold buffers by handle: drop them before the buffers.
   metrics_.reset();

@@ -8,7 +8,7 @@
 #include "core/sleep.h"
 #include "kernels/han2012/fused/han_soa.h"
 #include "models/block_threads.h"
-#include "models/han2012/reference/model.h"
+#include "models/han2012/reference/han_reference.h"
 
 #include <array>
 #include <cstdint>

@@ -5,6 +5,7 @@
 
 #include "core/hair_model.h"
 #include "core/sleep.h"
+#include "models/han2012/settings.h"
 
 #include <cstdint>
 #include <memory>
@@ -33,14 +34,12 @@ class HanModel final : public HairModel {
   }
 
  private:
-  // Per-region solver settings, read once in reset().
-  struct RegionSettings {
-    float damping, global_stiffness, global_range, local_stiffness;
-    int local_iterations, length_iterations;
-    bool global_ramp;
-    Method method;      // this region's local shape method (§6: LOD by region)
-    bool global_pass;   // false when S_G or the range is 0 and inert stages are skipped
-    bool local_pass;    // false when S_L is 0 or there are no local iterations
+  // Per-region solver settings: the region's parameters (settings.h, read once in reset())
+  // and what reset() decides from them.
+  struct RegionSettings : han::RegionSettings {
+    Method local_method;  // this region's local shape method (§6: LOD by region)
+    bool global_pass;     // false when S_G or the range is 0 and inert stages are skipped
+    bool local_pass;      // false when S_L is 0 or there are no local iterations
   };
   void substep(const Affine3f& head, const FrameInput& in, const FramePlan& plan, float dt, StageTimes& times);
   template <class F>

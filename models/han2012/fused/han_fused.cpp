@@ -1,7 +1,8 @@
-#include "models/han2012/fused/model.h"
+#include "models/han2012/fused/han_fused.h"
 
 #include "core/parallel.h"
 #include "kernels/han2012/reference/han_kernels.h"
+#include "models/han2012/settings.h"
 
 #include <algorithm>
 #include <chrono>
@@ -27,27 +28,25 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   region_.clear();
   std::vector<int> region_method;
   bool any_frames = false;
-  for (std::size_t r = 0; r < regions; ++r) {
+  const han::Settings settings = han::read_settings(params, regions);
+  for (const han::RegionSettings& given : settings.regions) {
     soa::BlockParams p{};
-    p.keep = 1.0f - static_cast<float>(params.get("damping", r));
-    p.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
-    const float range = static_cast<float>(params.get("global_range", r));
-    p.global_ramp = params.get_int("global_ramp", r) != 0;
+    p.keep = 1.0f - given.damping;
+    p.global_stiffness = given.global_stiffness;
+    p.global_ramp = given.global_ramp;
     // A pass whose stiffness or reach is 0 changes nothing and is not run (unless
     // ModelContext::skip_inert is off, the reference for that claim).
-    p.global_on = !ctx_.skip_inert || (p.global_stiffness != 0.0f && range != 0.0f);
-    p.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
-    p.local_iterations =
-        !ctx_.skip_inert || p.local_stiffness != 0.0f ? params.get_int("local_iterations", r) : 0;
-    p.length_iterations = params.get_int("length_iterations", r);
+    p.global_on = !ctx_.skip_inert || (p.global_stiffness != 0.0f && given.global_range != 0.0f);
+    p.local_stiffness = given.local_stiffness;
+    p.local_iterations = !ctx_.skip_inert || p.local_stiffness != 0.0f ? given.local_iterations : 0;
+    p.length_iterations = given.length_iterations;
     // global_reach depends on the strand's vertex count: set per block below.
-    p.global_reach = range;
+    p.global_reach = given.global_range;
     region_.push_back(p);
-    const int m = params.get_int("method", r);
-    region_method.push_back(m != 0 ? m : static_cast<int>(method_));
+    region_method.push_back(given.method != 0 ? given.method : static_cast<int>(method_));
     any_frames = any_frames || region_method.back() != 3;
   }
-  substeps_ = params.get_int("substeps");
+  substeps_ = settings.substeps;
 
   // Rest frames (Algorithm 2) with the per-strand kernel, for methods 1 and 2, and
   // method 2's frames across rounding-sized rest edges.

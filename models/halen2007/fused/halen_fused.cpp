@@ -1,7 +1,9 @@
-#include "models/halen2007/fused/model.h"
+#include "models/halen2007/fused/halen_fused.h"
 
 #include "core/parallel.h"
 #include "kernels/halen2007/reference/halen_kernels.h"
+#include "models/halen2007/cascade_settings.h"
+#include "models/halen2007/spring_settings.h"
 
 #include <algorithm>
 #include <chrono>
@@ -26,23 +28,40 @@ std::size_t HalenFusedModel::state_floats(int n) const {
   return model_ == Model::Forest ? soa::forest_state_floats(n) : soa::state_floats(n);
 }
 
+HalenFusedModel::Setup HalenFusedModel::read_settings(const ParamSet& params, std::size_t regions) {
+  Setup setup;
+  region_.clear();
+  if (model_ == Model::Spring) {
+    const halen_spring::Settings s = halen_spring::read_settings(params, regions);
+    for (const halen_spring::RegionSettings& r : s.regions) {
+      region_.push_back({1.0f - r.damping, r.tilt_min, r.length_iterations, {}});
+      setup.regions.push_back({r.stiffness, r.falloff_scale, 0.0f, r.falloff_exponent});
+    }
+    substeps_ = s.substeps;
+  } else if (model_ == Model::Cascade) {
+    const halen_cascade::Settings s = halen_cascade::read_settings(params, regions);
+    for (const halen_cascade::RegionSettings& r : s.regions) {
+      region_.push_back({1.0f - r.damping, 1.0f, r.length_iterations, {}});
+      setup.regions.push_back({r.stiffness, r.falloff_scale, r.down_fraction, r.falloff_exponent});
+    }
+    substeps_ = s.substeps;
+    setup.frames = s.frames;
+    setup.reactions = s.reactions;
+  } else {
+    const halen_forest::Settings s = halen_forest::read_settings(params, regions);
+    for (const halen_forest::RegionSettings& r : s.regions) {
+      region_.push_back({1.0f, 1.0f, 0, {r.joint_damping, r.drag, r.collision_stiffness, r.collision_damping}});
+      setup.regions.push_back({r.joint_stiffness, r.falloff_scale, 0.0f, r.falloff_exponent});
+    }
+    substeps_ = s.substeps;
+    setup.forest = s;
+  }
+  return setup;
+}
+
 void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   const bool forest = model_ == Model::Forest;
-  region_.clear();
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
-    Region g{1.0f, 1.0f, 0, {}};
-    if (forest) {
-      g.forest = {static_cast<float>(params.get("joint_damping", r)), static_cast<float>(params.get("drag", r)),
-                  static_cast<float>(params.get("collision_stiffness", r)),
-                  static_cast<float>(params.get("collision_damping", r))};
-    } else {
-      g.keep = 1.0f - static_cast<float>(params.get("damping", r));
-      g.length_iterations = params.get_int("length_iterations", r);
-      if (model_ == Model::Spring) g.tilt_min = static_cast<float>(params.get("tilt_min", r));
-    }
-    region_.push_back(g);
-  }
-  substeps_ = params.get_int("substeps");
+  const Setup setup = read_settings(params, rest.region_names.size());
 
   // Threads: contiguous ranges of strands of about equal cost (vertices times passes over
   // them), fixed at reset, so that no two threads write the same cache line of the
@@ -112,7 +131,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   }
   data_.assign(floats, 0.0f);
   state_.assign(state, 0.0f);
-  setup_blocks(rest, params);
+  setup_blocks(rest, setup);
 
   scratch_stride_ = forest ? soa::forest_scratch_floats(max_n) : soa::scratch_floats(max_n);
   scratch_.assign(scratch_stride_ * static_cast<std::size_t>(threads), 0.0f);
@@ -132,7 +151,7 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
 
 // Fills every block's fields and initial state (the hair at rest), with the per-strand
 // set-up the reference models use.
-void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
+void HalenFusedModel::setup_blocks(const Groom& rest, const Setup& setup) {
   const std::size_t nv = rest.vertex_count();
   const bool spring = model_ == Model::Spring, forest = model_ == Model::Forest;
   const std::vector<float> rest_length = rest_edge_lengths(rest);
@@ -140,32 +159,32 @@ void HalenFusedModel::setup_blocks(const Groom& rest, const ParamSet& params) {
   std::vector<int> base(nv);
   std::vector<k::Mat3f> space(spring ? 0 : nv);  // cascade: rest tangent spaces; forest: rest frames
   std::vector<Vec3f> up_local(spring ? 0 : nv), down_local(spring ? 0 : nv);
-  const auto axes = forest && params.get_int("axis_convention") == 0 ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
+  const auto axes = forest && setup.forest.parent_z_axes ? k::ForestAxes::ParentZ : k::ForestAxes::ParentX;
   forest_frame_.parent_x = axes == k::ForestAxes::ParentX;
-  forest_frame_.mass_inertia = forest && params.get_int("inertia") == 0;
-  forest_frame_.gravity_compensation = forest && params.get_int("gravity_compensation") != 0;
-  forest_root_angular_ = forest && params.get_int("root_angular_acceleration") != 0;
+  forest_frame_.mass_inertia = forest && setup.forest.mass_inertia;
+  forest_frame_.gravity_compensation = forest && setup.forest.gravity_compensation;
+  forest_root_angular_ = forest && setup.forest.root_angular_acceleration;
   forest_rest_ = {};
-  forest_rest_.hold = forest && !forest_frame_.mass_inertia && params.get_int("rest_hold") != 0;
+  forest_rest_.hold = forest && !forest_frame_.mass_inertia && setup.forest.rest_hold;
   if (!spring && !forest) {
-    cascade_frames_ = static_cast<k::CascadeFrames>(params.get_int("frames"));
-    cascade_reactions_ = params.get_int("reactions") != 0;
+    cascade_frames_ = static_cast<k::CascadeFrames>(setup.frames);
+    cascade_reactions_ = setup.reactions;
   }
   inv_length_.assign(rest.strand_count(), 0.0f);
   for (std::size_t s = 0; s < rest.strand_count(); ++s) {
-    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s), r = rest.strand_region[s];
+    const std::size_t b = rest.strand_begin(s), n = rest.strand_size(s);
+    const Setup::RegionSetup& r = setup.regions[rest.strand_region[s]];
     const auto strand_rest = std::span(rest.positions).subspan(b, n);
-    const float c = static_cast<float>(params.get("falloff_scale", r));
-    const int a = params.get_int("falloff_exponent", r);
+    const float c = r.falloff_scale;
+    const int a = r.falloff_exponent;
     auto at = [&](auto& v) { return std::span(v).subspan(b, n); };
     if (spring)
-      k::spring_setup(strand_rest, static_cast<float>(params.get("stiffness", r)), c, a, at(k_up), at(lift));
+      k::spring_setup(strand_rest, r.stiffness, c, a, at(k_up), at(lift));
     else if (!forest)
-      k::cascade_setup(strand_rest, static_cast<float>(params.get("stiffness", r)), c, a,
-                       static_cast<float>(params.get("down_fraction", r)), cascade_frames_, at(inv_mass), at(k_up),
+      k::cascade_setup(strand_rest, r.stiffness, c, a, r.down_fraction, cascade_frames_, at(inv_mass), at(k_up),
                        at(k_down), at(lift), at(base), at(lever), at(space), at(up_local), at(down_local));
     else
-      inv_length_[s] = k::forest_setup(strand_rest, axes, static_cast<float>(params.get("joint_stiffness", r)), c, a,
+      inv_length_[s] = k::forest_setup(strand_rest, axes, r.stiffness, c, a,
                                        at(space), at(theta0), at(phi0), at(length), at(k_up));
   }
   const bool cascade = !spring && !forest;

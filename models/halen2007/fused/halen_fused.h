@@ -12,6 +12,7 @@
 #include "kernels/halen2007/reference/halen_kernels.h"
 #include "kernels/halen2007/fused/halen_soa.h"
 #include "models/block_threads.h"
+#include "models/halen2007/forest_settings.h"
 
 #include <array>
 #include <limits>
@@ -58,7 +59,21 @@ class HalenFusedModel final : public HairModel {
   static constexpr std::uint32_t kNoStrand = 0xffffffffu;
   std::size_t block_floats(int n) const;
   std::size_t state_floats(int n) const;
-  void setup_blocks(const Groom& rest, const ParamSet& params);
+  // The model's settings (spring_settings.h, cascade_settings.h or forest_settings.h, read
+  // there) in the one shape the blocks are set up from.
+  struct Setup {
+    struct RegionSetup {
+      float stiffness, falloff_scale, down_fraction;  // the forest's joint stiffness as stiffness
+      int falloff_exponent;
+    };
+    std::vector<RegionSetup> regions;
+    halen_forest::Settings forest{};  // the forest's: its model-wide switches
+    int frames = 0;
+    bool reactions = false;
+  };
+  // region_ and substeps_ from the model's settings; what the blocks need returned.
+  Setup read_settings(const ParamSet& params, std::size_t regions);
+  void setup_blocks(const Groom& rest, const Setup& setup);
   void forest_substeps(const FrameInput& in, float dt);
   void feed_block(const BlockInfo& b, kernels::soa::LineFeed& feed) const;
   void run_thread(int t);

@@ -1,4 +1,4 @@
-#include "models/plante2001/fused/model.h"
+#include "models/plante2001/fused/wisp_fused.h"
 
 #include <algorithm>
 

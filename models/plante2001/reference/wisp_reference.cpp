@@ -1,4 +1,4 @@
-#include "models/plante2001/reference/model.h"
+#include "models/plante2001/reference/wisp_reference.h"
 
 #include <limits>
 

@@ -3,7 +3,7 @@
 // around the wisp-wisp response on the steps that detect), consecutive wisps of one node
 // count and parameter set integrated 16 at a time, one wisp per vector lane, and the
 // vector narrow phase (kernels/plante2001/fused/). Bit-identical to plante_wisp_ref
-// (reference/model.h) for any thread count and ISA variant.
+// (reference/wisp_reference.h) for any thread count and ISA variant.
 #pragma once
 
 #include "kernels/plante2001/fused/wisp_soa.h"

@@ -11,7 +11,7 @@
 #include "kernels/han2012/vulkan/han_layout.h"
 #include "kernels/vulkan/metrics.h"
 #include "kernels/vulkan/runtime.h"
-#include "models/han2012/reference/model.h"
+#include "models/han2012/reference/han_reference.h"
 
 #include <cstdint>
 #include <memory>

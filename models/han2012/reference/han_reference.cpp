@@ -1,8 +1,9 @@
-#include "models/han2012/reference/model.h"
+#include "models/han2012/reference/han_reference.h"
 
 #include "core/parallel.h"
 #include "kernels/common/strand_kernels.h"
 #include "kernels/han2012/reference/han_kernels.h"
+#include "models/han2012/settings.h"
 
 #include <algorithm>
 
@@ -35,26 +36,18 @@ void HanModel::reset(const Groom& rest, const ParamSet& params) {
   region_.clear();
   max_iterations_ = 0;
   any_global_pass_ = any_local_pass_ = false;
-  for (std::size_t r = 0; r < rest.region_names.size(); ++r) {
-    RegionSettings rs{};
-    rs.damping = static_cast<float>(params.get("damping", r));
-    rs.global_stiffness = static_cast<float>(params.get("global_stiffness", r));
-    rs.global_range = static_cast<float>(params.get("global_range", r));
-    rs.global_ramp = params.get_int("global_ramp", r) != 0;
-    rs.local_stiffness = static_cast<float>(params.get("local_stiffness", r));
-    rs.local_iterations = params.get_int("local_iterations", r);
-    rs.length_iterations = params.get_int("length_iterations", r);
-    const int method = params.get_int("method", r);
-    rs.method = method == 0 ? method_ : static_cast<Method>(method);
+  const Settings settings = read_settings(params, rest.region_names.size());
+  for (const han::RegionSettings& given : settings.regions) {
     // A pass whose stiffness or reach is 0 changes nothing, so it is not run.
-    rs.global_pass = !ctx_.skip_inert || (rs.global_stiffness != 0.0f && rs.global_range != 0.0f);
-    rs.local_pass = rs.local_iterations > 0 && (!ctx_.skip_inert || rs.local_stiffness != 0.0f);
+    const RegionSettings rs{given, given.method == 0 ? method_ : static_cast<Method>(given.method),
+                            !ctx_.skip_inert || (given.global_stiffness != 0.0f && given.global_range != 0.0f),
+                            given.local_iterations > 0 && (!ctx_.skip_inert || given.local_stiffness != 0.0f)};
     any_global_pass_ = any_global_pass_ || rs.global_pass;
     any_local_pass_ = any_local_pass_ || rs.local_pass;
     max_iterations_ = std::max({max_iterations_, rs.local_iterations, rs.length_iterations});
     region_.push_back(rs);
   }
-  substeps_ = params.get_int("substeps");
+  substeps_ = settings.substeps;
   sleep_.reset(rest.strand_count());
 }
 
@@ -127,7 +120,7 @@ void HanModel::substep(const Affine3f& head, const FrameInput& in, const FramePl
         const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
         const auto rest_rot = std::span<const Quatf>(rest_rotation_).subspan(b, n);
         const auto rest_loc = std::span<const Vec3f>(rest_local_).subspan(b, n);
-        switch (r.method) {
+        switch (r.local_method) {
           case Method::Serial:
             k::local_shape_m1(strand(pos_, s), rest_rot, rest_loc, head_rotation, r.local_stiffness);
             break;
