@@ -255,12 +255,17 @@ void print_run(const nlohmann::json& r) {
     std::snprintf(buf, sizeof buf, fmt, v.get<double>());
     return std::string(buf);
   };
-  const auto& m = r["metrics"];
-  std::printf("  %-14s %-9s %9s ms %8s ns/v  dev %-9s jag %-9s len %-9s rest %-9s\n", label.c_str(),
-              r["status"].get<std::string>().c_str(), f(r["timing"]["step_ms"]["median"], "%.3f").c_str(),
-              f(r["timing"]["ns_per_vertex"], "%.1f").c_str(), f(m["deviation_vs_reference"]["rms"], "%.3g").c_str(),
-              f(m["jaggedness"]["mean"], "%.3g").c_str(), f(m["length_error"]["rms"], "%.2g").c_str(),
-              f(m["rest_shape_error"], "%.3g").c_str());
+  std::printf("  %-14s %-9s %9s ms %8s ns/v ", label.c_str(), r["status"].get<std::string>().c_str(),
+              f(r["timing"]["step_ms"]["median"], "%.3f").c_str(), f(r["timing"]["ns_per_vertex"], "%.1f").c_str());
+  // Each metric the table abbreviates, by its headline summary (reports/frame_metrics.h).
+  for (const metrics::FrameMetric& fm : metrics::frame_metrics()) {
+    if (fm.cli.empty()) continue;
+    const metrics::Summary& s = fm.summaries.front();
+    const nlohmann::json& v = r["metrics"][std::string(fm.name)];
+    std::printf(" %s %-9s", std::string(fm.cli).c_str(),
+                f(s.key.empty() ? v : v[std::string(s.key)], std::string(s.format).c_str()).c_str());
+  }
+  std::printf("\n");
   // GPU runs: the device time back to back and in lockstep (docs/vulkan.md, Timing).
   const auto& t = r["timing"];
   if (t.contains("gpu_ms"))

@@ -215,10 +215,17 @@ json merge_reports(const std::vector<ShardReport>& in, bool mix_machines) {
   for (std::size_t i = 0; i < in.size(); ++i)
     for (const json& run : in[i].report["runs"]) by_key[i][run_key(run)] = &run;
 
+  // The shards' metric tables must be one table: a shard from another hairbench build
+  // would put its numbers under the same names with other meanings.
+  for (std::size_t i = 1; i < in.size(); ++i)
+    if (in[i].report.value("metric_definitions", json()) != in.front().report.value("metric_definitions", json()))
+      throw InputError(in[i].file, "metric_definitions",
+                       "differs from " + in.front().file + "'s: the shards come from different hairbench builds");
   json report = {{"schema", "hairbench-report"},
                  {"schema_version", in.front().report.value("schema_version", 3)},
                  {"context", merged_context(in)},
-                 {"snapshot_encoding", kSnapshotEncoding}};
+                 {"snapshot_encoding", kSnapshotEncoding},
+                 {"metric_definitions", in.front().report.value("metric_definitions", json())}};
   json runs = json::array(), scenario_list = json::array();
   std::set<std::string> listed;
   for (const auto& [key, i] : held) {

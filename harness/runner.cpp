@@ -549,96 +549,76 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
     l.running = false;
     // Keep the series aligned with the frames that ran: null for the one that diverged.
     r.t.push_back(in.t);
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (auto* v : {&r.deviation, &r.jaggedness, &r.length_rms, &r.length_max, &r.rest_shape_error, &r.penetration})
-      v->push_back(nan);
-    if (guides_)
-      for (auto* v : {&r.penetration_guides, &r.penetration_follow}) v->push_back(nan);
+    for (std::size_t c = 0; c < metrics::column_count(); ++c)
+      if (guides_ || !metrics::column(c).follow_only) r.frame_values[c].push_back(std::numeric_limits<double>::quiet_NaN());
   }
 }
 
-namespace {
-// The per-frame values measure() records for each lane.
-enum FrameMetric { kDeviation, kJaggedness, kLength, kRestShape, kPenetration, kFollowPenetration, kFrameMetrics };
-}  // namespace
-
-// The per-frame metrics cost as much as a fast model's step, so they run on the pool:
-// one task per lane and metric. A device lane's were computed by its kernel with the
-// divergence tests (stop_diverged); here its strands are added up.
+// The per-frame metrics (reports/frame_metrics.h) cost as much as a fast model's step, so
+// they run on the pool: one task per lane and metric, and one per lane for the edges the
+// stretched verdict reads where they are not the whole groom's (a model's nodes, or the
+// guides of rebuilt follow hairs). A device lane's strands were reduced by its kernel
+// with the divergence tests (stop_diverged); its metrics add them up, but for a metric
+// with no device half, which reads its positions.
 void LockstepRun::measure(const FrameInput& in) {
+  const auto table = metrics::frame_metrics();
+  const std::size_t tasks = table.size() + 1;  // the last: the stretched verdict's edges
   const bool ref_ok = lanes_[0].running;
-  std::vector<std::array<double, kFrameMetrics>> values(lanes_.size());
-  std::vector<metrics::LengthError> length(lanes_.size()), guide_length(lanes_.size());
-  // The reference's positions for the host lanes, fetched once (a device reference reads
-  // them back here) before the tasks share them.
+  std::vector<std::vector<double>> values(lanes_.size(), std::vector<double>(metrics::column_count()));
+  std::vector<std::optional<metrics::LengthError>> stretch(lanes_.size());
+  // The positions the host halves read, fetched once before the tasks share them (a
+  // device model brings them back here): every host lane's, a device lane's where a
+  // metric has no device half, and the reference's for any lane measured on the host.
+  const bool host_only = std::any_of(table.begin(), table.end(), [](const auto& fm) { return !fm.device; });
+  std::vector<std::span<const Vec4f>> p(lanes_.size());
   bool host_lanes = false;
-  for (const Lane& l : lanes_) host_lanes |= l.running && !l.device;
-  const std::span<const Vec4f> reference =
-      ref_ok && host_lanes ? lanes_[0].model->positions() : std::span<const Vec4f>();
-  const std::size_t guide_strands = guides_ ? guides_->groom->strand_count() : 0;
-  for (std::size_t i = 0; i < lanes_.size(); ++i) {
-    const Lane& l = lanes_[i];
-    if (!l.running || !l.device) continue;
-    const std::span<const StrandMetrics> m = l.strands;
-    auto& v = values[i];
-    v[kDeviation] = ref_ok ? metrics::deviation(rest_, m) : std::numeric_limits<double>::quiet_NaN();
-    v[kJaggedness] = metrics::jaggedness(rest_, m);
-    length[i] = metrics::length_error(rest_, m);
-    guide_length[i] = guides_ ? metrics::length_error(*guides_, m.first(guide_strands)) : length[i];
-    v[kRestShape] = metrics::rest_shape_error(rest_, m);
-    v[kPenetration] = metrics::penetration(guides_ ? m.first(guide_strands) : m);
-    v[kFollowPenetration] = guides_ ? metrics::penetration(m.subspan(guide_strands)) : 0.0;
-  }
-  pool_.parallel_for(lanes_.size() * kFrameMetrics, [&](std::size_t b, std::size_t e) {
+  for (std::size_t i = 0; i < lanes_.size(); ++i)
+    if (lanes_[i].running && (!lanes_[i].device || host_only)) {
+      p[i] = lanes_[i].model->positions();
+      host_lanes = true;
+    }
+  if (ref_ok && host_lanes && p[0].empty()) p[0] = lanes_[0].model->positions();
+  pool_.parallel_for(lanes_.size() * tasks, [&](std::size_t b, std::size_t e) {
     for (std::size_t task = b; task < e; ++task) {
-      const std::size_t i = task / kFrameMetrics;
-      if (!lanes_[i].running || lanes_[i].device) continue;
-      const auto p = lanes_[i].model->positions();
-      auto& v = values[i];
-      switch (static_cast<FrameMetric>(task % kFrameMetrics)) {
-        case kDeviation:
-          v[kDeviation] = ref_ok ? metrics::deviation(p, reference, rest_.mean_strand_length)
-                                 : std::numeric_limits<double>::quiet_NaN();
-          break;
-        case kJaggedness: v[kJaggedness] = metrics::jaggedness(rest_, p); break;
-        case kLength:
-          length[i] = metrics::length_error(rest_, p);
-          if (lanes_[i].nodes)
-            guide_length[i] = metrics::length_error(*lanes_[i].nodes, lanes_[i].model->simulated_positions());
-          else
-            guide_length[i] =
-                guides_ ? metrics::length_error(*guides_, p.first(sc_.guides.vertex_count())) : length[i];
-          break;
-        case kRestShape: v[kRestShape] = metrics::rest_shape_error(rest_, p, in.head); break;
-        // With follow hairs, the guides' and the follow hairs' apart; the larger is the
-        // groom's, the same number as one pass over every vertex.
-        case kPenetration:
-          v[kPenetration] = metrics::penetration(guides_ ? p.first(sc_.guides.vertex_count()) : p, spheres_);
-          break;
-        case kFollowPenetration:
-          v[kFollowPenetration] = guides_ ? metrics::penetration(p.subspan(sc_.guides.vertex_count()), spheres_) : 0.0;
-          break;
-        case kFrameMetrics: break;
+      const std::size_t i = task / tasks, m = task % tasks;
+      const Lane& l = lanes_[i];
+      if (!l.running) continue;
+      if (m == table.size()) {
+        if (l.nodes)
+          stretch[i] = metrics::length_error(*l.nodes, l.model->simulated_positions());
+        else if (guides_ && l.device)
+          stretch[i] = metrics::length_error(*guides_, l.strands.first(guides_->groom->strand_count()));
+        else if (guides_)
+          stretch[i] = metrics::length_error(*guides_, p[i].first(guides_->groom->vertex_count()));
+        continue;
       }
+      const metrics::FrameMetric& fm = table[m];
+      const bool on_device = l.device && fm.device;
+      metrics::FrameView view{rest_, guides_ ? &*guides_ : nullptr, {}, {}, {}, ref_ok, in.head, spheres_};
+      if (on_device) {
+        view.strands = l.strands;
+      } else {
+        view.p = p[i];
+        if (ref_ok) view.reference = p[0];
+      }
+      (on_device ? fm.device : fm.host)(view, std::span(values[i]).subspan(metrics::first_column(m), fm.columns.size()));
     }
   });
+  // Where no other groom holds the simulated edges, the stretched verdict reads the
+  // whole groom's length error, worst edge included (its last columns).
+  static const std::size_t length = metrics::column_index("length_error_rms");
   for (std::size_t i = 0; i < lanes_.size(); ++i) {
     Lane& l = lanes_[i];
     if (!l.running) continue;
     RunRecord& r = l.record;
-    const auto& v = values[i];
     r.t.push_back(in.t);
-    r.deviation.push_back(v[kDeviation]);
-    r.jaggedness.push_back(v[kJaggedness]);
-    r.length_rms.push_back(length[i].rms);
-    r.length_max.push_back(length[i].max);
-    r.rest_shape_error.push_back(v[kRestShape]);
-    r.penetration.push_back(std::max(v[kPenetration], v[kFollowPenetration]));
-    if (guides_) {
-      r.penetration_guides.push_back(v[kPenetration]);
-      r.penetration_follow.push_back(v[kFollowPenetration]);
-    }
-    l.stretch.add(in.frame, guide_length[i]);
+    for (std::size_t c = 0; c < values[i].size(); ++c)
+      if (guides_ || !metrics::column(c).follow_only) r.frame_values[c].push_back(values[i][c]);
+    const auto& v = values[i];
+    l.stretch.add(in.frame, stretch[i] ? *stretch[i]
+                                       : metrics::LengthError{v[length], v[length + 1],
+                                                              static_cast<std::uint32_t>(v[length + 2]),
+                                                              static_cast<std::uint32_t>(v[length + 3])});
   }
 }
 

@@ -116,7 +116,28 @@ def load(path):
         raise ReportError("schema: not a hairbench-report")
     if report.get("schema_version") not in SCHEMA_VERSIONS:
         raise ReportError(f"schema_version: {report.get('schema_version')!r} is not one of {SCHEMA_VERSIONS}")
+    defs = report.get("metric_definitions")
+    if not isinstance(defs, list) or not all(isinstance(d, dict) and isinstance(d.get("summaries"), list)
+                                             and isinstance(d.get("columns"), list) for d in defs):
+        raise ReportError("metric_definitions: missing or not a list of metrics (a report from a hairbench "
+                          "before the metric table: run hairbench again)")
     return report
+
+
+def timeseries_panels(report):
+    """(series key, y label) of each metric drawn over time (metric_definitions)."""
+    return [(next(c["name"] for c in d["columns"] if c["reported"]), d["timeseries_label"])
+            for d in report["metric_definitions"] if d.get("timeseries_label")]
+
+
+def summary_columns(report):
+    """(metric, summary) of each summary the tables show (metric_definitions, in order)."""
+    return [(d, s) for d in report["metric_definitions"] for s in d["summaries"] if s.get("label")]
+
+
+def summary_value(run, metric, summary):
+    v = run["metrics"].get(metric["name"])
+    return v if not summary["key"] else (v or {}).get(summary["key"])
 
 
 def asleep(run):
@@ -394,14 +415,15 @@ def shade_phases(ax, info):
 def chart_timeseries(report, out_dir, stem, written, svg):
     names = scenario_names(report)
     colours = model_colours(report)
-    fig, axes = plt.subplots(len(names), 2, figsize=(13, 3.3 * len(names)), squeeze=False)
+    metrics = timeseries_panels(report)
+    fig, axes = plt.subplots(len(names), len(metrics), figsize=(6.5 * len(metrics), 3.3 * len(names)),
+                             squeeze=False)
     panels = []
     for row, name in zip(axes, names):
         runs = [r for r in report["runs"] if r["scenario"] == name]
         info = scenario_info(report, name)
         panel = {"scenario": name, "phases": len((info or {}).get("phases", []))}
-        for ax, key, ylabel in ((row[0], "deviation_vs_reference", "deviation vs reference (/ L̄)"),
-                                (row[1], "jaggedness", "jaggedness")):
+        for ax, (key, ylabel) in zip(row, metrics):
             shade_phases(ax, info)
             drawn = 0
             for r in runs:
@@ -427,7 +449,7 @@ def chart_timeseries(report, out_dir, stem, written, svg):
         if info and info.get("snapshots", {}).get("frames"):
             handles.append(plt.Line2D([], [], color="black", lw=0.8, ls=":"))
             labels.append("most violent frame")
-        row[1].legend(handles, labels, fontsize=7, loc="upper right", ncol=2 if len(labels) > 8 else 1)
+        row[-1].legend(handles, labels, fontsize=7, loc="upper right", ncol=2 if len(labels) > 8 else 1)
         panels.append(panel)
     fig.tight_layout()
     return {"files": save(fig, out_dir, stem, "timeseries", written, svg), "panels": panels}
@@ -663,24 +685,23 @@ def chart_strands(report, out_dir, stem, written, svg):
 
 # --- tables -----------------------------------------------------------------------------
 
-COLUMNS = ["model", "knob", "status", "median step ms", "ns/vertex", "deviation RMS", "deviation max",
-           "jaggedness mean", "length error RMS", "rest shape error", "penetration max (m)", "Pareto",
-           "material card (vs reference)"]
+def table_columns(report):
+    return (["model", "knob", "status", "median step ms", "ns/vertex"]
+            + [s["label"] for _, s in summary_columns(report)] + ["Pareto", "material card (vs reference)"])
 
 
 def table_rows(report, name, pareto):
     rows = []
     front = {(p["model"], json.dumps(p["knob"], sort_keys=True)) for p in pareto}
+    shown = summary_columns(report)
     for r in report["runs"]:
         if r["scenario"] != name:
             continue
-        m = r["metrics"]
         on_front = (r["model"], json.dumps(r.get("knob"), sort_keys=True)) in front
         rows.append([r["model"], knob_text(r) or "–", verdict_text(r), fmt(r["timing"]["step_ms"]["median"]),
-                     fmt(r["timing"]["ns_per_vertex"], ".1f"), fmt(m["deviation_vs_reference"]["rms"]),
-                     fmt(m["deviation_vs_reference"]["max"]), fmt(m["jaggedness"]["mean"]),
-                     fmt(m["length_error"]["rms"], ".2g"), fmt(m["rest_shape_error"]),
-                     fmt(m["penetration"]["max"], ".2g"), "yes" if on_front else "", card_text(r) or "–"])
+                     fmt(r["timing"]["ns_per_vertex"], ".1f")]
+                    + [fmt(summary_value(r, d, s), s["format"].lstrip("%")) for d, s in shown]
+                    + ["yes" if on_front else "", card_text(r) or "–"])
     return rows
 
 
@@ -744,7 +765,8 @@ def write_markdown(report, path, pareto_by_scenario):
     for name in scenario_names(report):
         lines += [f"## {name}", ""]
         lines += [f"- {n}" for n in scenario_notes(report, name)]
-        lines += ["", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+        columns = table_columns(report)
+        lines += ["", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
         for row in table_rows(report, name, pareto_by_scenario.get(name, [])):
             lines.append("| " + " | ".join(row) + " |")
         lines.append("")
@@ -878,14 +900,17 @@ def write_html(report, path, charts, pareto_by_scenario):
     for name in scenario_names(report):
         parts.append(f"<h3>{e(name)}</h3><ul>")
         parts += [f"<li>{e(n)}</li>" for n in scenario_notes(report, name)]
-        parts.append("</ul><table><tr>" + "".join(f"<th>{e(c)}</th>" for c in COLUMNS) + "</tr>")
+        columns = table_columns(report)
+        pareto = columns.index("Pareto")
+        parts.append("</ul><table><tr>" + "".join(f"<th>{e(c)}</th>" for c in columns) + "</tr>")
         for row in table_rows(report, name, pareto_by_scenario.get(name, [])):
-            cls = " class='front'" if row[-1] else ""
+            cls = " class='front'" if row[pareto] else ""
             parts.append(f"<tr{cls}>" + "".join(f"<td>{e(c)}</td>" for c in row) + "</tr>")
         parts.append("</table>")
     parts.append("<h2>Charts</h2>")
-    parts.append(img_tag(charts["timeseries"]["files"][0], "Deviation from the reference and jaggedness over "
-                         "time; script phases shaded, the most violent frame dotted"))
+    drawn = " and ".join(label for _, label in timeseries_panels(report))
+    parts.append(img_tag(charts["timeseries"]["files"][0], f"Over time: {drawn}; script phases shaded, the most "
+                         "violent frame dotted"))
     parts.append(img_tag(charts["stages"]["files"][0], "Time per solver stage (mean per step); the legend lists the "
                          "stages each run skipped"))
     for s in charts["strands"]:

@@ -207,15 +207,22 @@ def judge_counts(base, cand, threshold):
 
 # --- Accuracy from hairbench reports -----------------------------------------------
 
-# metric path in a run -> (relative tolerance, absolute floor). A candidate value may
-# exceed the baseline by max(rel * baseline, abs): the floors sit well above float
-# reordering noise (~1e-6 of L) and below the differences between methods (~1e-3).
-ACCURACY_TOLERANCES = {
-    ("deviation_vs_reference", "rms"): (0.10, 1e-4),
-    ("jaggedness", "mean"): (0.10, 1e-4),
-    ("length_error", "rms"): (0.10, 1e-4),
-    ("rest_shape_error",): (0.10, 1e-4),
-}
+def accuracy_tolerances(path, doc):
+    """metric path in a run -> (relative tolerance, absolute floor), from the report's
+    metric_definitions (hairbench's metric table, reports/frame_metrics.h): each summary
+    with a gate. A candidate value may exceed the baseline by max(rel * baseline, abs)."""
+    defs = doc.get("metric_definitions") if isinstance(doc, dict) else None
+    if not isinstance(defs, list):
+        raise GateError(f"{path}: metric_definitions: missing (a report from a hairbench before the metric "
+                        "table: run the candidate's hairbench again)")
+    out = {}
+    for d in defs:
+        for s in d.get("summaries", []):
+            gate = s.get("gate")
+            if isinstance(gate, dict):
+                key = (d["name"], s["key"]) if s.get("key") else (d["name"],)
+                out[key] = (float(gate["rel"]), float(gate["abs"]))
+    return out
 
 
 def _metric(run, path):
@@ -240,7 +247,10 @@ def _runs_by_key(path, doc):
 
 
 def judge_accuracy(base_path, base_doc, cand_path, cand_doc):
+    """Rows (run, metric, baseline, candidate, verdict) for every gated metric of the
+    candidate's table."""
     base, cand = _runs_by_key(base_path, base_doc), _runs_by_key(cand_path, cand_doc)
+    tolerances = accuracy_tolerances(cand_path, cand_doc)
     rows = []
     for key in sorted(set(base) & set(cand)):
         b, c = base[key], cand[key]
@@ -248,7 +258,7 @@ def judge_accuracy(base_path, base_doc, cand_path, cand_doc):
         if b.get("status") == "ok" and c.get("status") != "ok":
             rows.append((label, "status", "ok", c.get("status"), "REGRESSION (no longer ok)"))
             continue
-        for path, (rel, floor) in ACCURACY_TOLERANCES.items():
+        for path, (rel, floor) in tolerances.items():
             vb, vc = _metric(b, path), _metric(c, path)
             if vb is None or vc is None:
                 continue
@@ -323,11 +333,12 @@ def main(argv=None):
         if args.baseline_report or args.candidate_report:
             if not (args.baseline_report and args.candidate_report):
                 raise GateError("--baseline-report and --candidate-report go together")
+            cand_doc = load_json(args.candidate_report)
             rows = judge_accuracy(args.baseline_report, load_json(args.baseline_report),
-                                  args.candidate_report, load_json(args.candidate_report))
+                                  args.candidate_report, cand_doc)
             failed |= any(r[4].startswith("REGRESSION") for r in rows)
             tol = ", ".join(f"{'.'.join(k)} +max({r:.0%}, {a:g})"
-                            for k, (r, a) in ACCURACY_TOLERANCES.items())
+                            for k, (r, a) in accuracy_tolerances(args.candidate_report, cand_doc).items())
             sections.append(f"### Accuracy (tolerances: {tol}; a run no longer ok "
                             "fails)\n\n" + accuracy_table(rows))
         if not sections:

@@ -236,6 +236,56 @@ nlohmann::json context_json(const ReportContext& ctx) {
                                             : ctx.plugins}};
 }
 
+namespace {
+
+double summarise(const RunRecord& r, std::size_t done, const std::vector<double>& v, metrics::Stat stat) {
+  switch (stat) {
+    case metrics::Stat::rms: return rms(v);
+    case metrics::Stat::mean: return finite_mean(v);
+    case metrics::Stat::max: return finite_max(v);
+    case metrics::Stat::final: return v.empty() ? NAN : v.back();
+    case metrics::Stat::settled_mean: {
+      // The frames that end at or after settle_from.
+      std::vector<double> settled;
+      for (std::size_t f = 0; f < done; ++f)
+        if (r.t[f] >= r.settle_from - 1e-9) settled.push_back(v[f]);
+      return finite_mean(settled);
+    }
+  }
+  return NAN;
+}
+
+// runs[].metrics: each metric of the table (reports/frame_metrics.h), by its summaries;
+// a follow-only column's summary only where follow hairs were rebuilt.
+nlohmann::json frame_metrics_json(const RunRecord& r, std::size_t done) {
+  nlohmann::json out = nlohmann::json::object();
+  const auto table = metrics::frame_metrics();
+  for (std::size_t m = 0; m < table.size(); ++m) {
+    const metrics::FrameMetric& fm = table[m];
+    nlohmann::json j = nlohmann::json::object();
+    for (const metrics::Summary& s : fm.summaries) {
+      const std::size_t c = metrics::first_column(m) + s.column;
+      if (fm.columns[s.column].follow_only && r.frame_values[c].empty()) continue;
+      const nlohmann::json value = num(summarise(r, done, r.frame_values[c], s.stat));
+      if (s.key.empty())
+        j = value;
+      else
+        j[std::string(s.key)] = value;
+    }
+    // A deviation is a measure of accuracy only against a reference that is ok.
+    if (fm.against_reference) {
+      j["reference"] = r.reference;
+      j["reference_status"] = std::string(verdict::status_name(r.reference_status));
+      if (!r.reference_overrides.empty()) j["reference_overrides"] = r.reference_overrides;
+      if (!r.reference_reason.empty()) j["reference_reason"] = r.reference_reason;
+    }
+    out[std::string(fm.name)] = std::move(j);
+  }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   const std::size_t done = r.step_ms.size();
   // The headline times cover the frames where the model worked: a frame in which every
@@ -280,32 +330,9 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   }
   if (!r.gpu_ms_lockstep.empty()) timing["gpu_ms_lockstep"] = summary(r.gpu_ms_lockstep);
 
-  // rest_shape_error averages the frames that end at or after settle_from.
-  std::vector<double> settled;
-  for (std::size_t f = 0; f < done; ++f)
-    if (r.t[f] >= r.settle_from - 1e-9) settled.push_back(r.rest_shape_error[f]);
-
-  nlohmann::json deviation = {{"reference", r.reference},
-                               {"reference_status", std::string(verdict::status_name(r.reference_status))},
-                               {"rms", num(rms(r.deviation))},
-                               {"max", num(finite_max(r.deviation))},
-                               {"final", num(r.deviation.empty() ? NAN : r.deviation.back())}};
-  if (!r.reference_overrides.empty()) deviation["reference_overrides"] = r.reference_overrides;
-  if (!r.reference_reason.empty()) deviation["reference_reason"] = r.reference_reason;
-  nlohmann::json metrics = {
-      {"deviation_vs_reference", std::move(deviation)},
-      {"jaggedness", {{"mean", num(finite_mean(r.jaggedness))}, {"max", num(finite_max(r.jaggedness))}}},
-      {"length_error", {{"rms", num(rms(r.length_rms))}, {"max", num(finite_max(r.length_max))}}},
-      {"rest_shape_error", num(finite_mean(settled))},
-      {"material", material::card_json(r.card, &r.reference_card)},
-      {"penetration", {{"max", num(finite_max(r.penetration))}}},
-      {"state_hash", metrics::hash_hex(r.state_hash)}};
-  // Follow hairs are rebuilt from their guides and not collided (as TressFX does not):
-  // their penetration is the follow layer's, apart from the guides' that the model holds.
-  if (!r.penetration_follow.empty()) {
-    metrics["penetration"]["guides_max"] = num(finite_max(r.penetration_guides));
-    metrics["penetration"]["follow_max"] = num(finite_max(r.penetration_follow));
-  }
+  nlohmann::json metrics = frame_metrics_json(r, done);
+  metrics["material"] = material::card_json(r.card, &r.reference_card);
+  metrics["state_hash"] = metrics::hash_hex(r.state_hash);
 
   nlohmann::json failure = nullptr;
   if (r.failure) failure = {{"frame", r.failure->frame}, {"t", r.failure->t}, {"reason", r.failure->reason}};
@@ -338,20 +365,14 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
                        {"series",
                         {{"t", series(r.t)},
                          {"step_ms", series(r.step_ms)},
-                         {"worked", r.worked},
-                         {"deviation_vs_reference", series(r.deviation)},
-                         {"jaggedness", series(r.jaggedness)},
-                         {"length_error_rms", series(r.length_rms)},
-                         {"rest_shape_error", series(r.rest_shape_error)},
-                         {"penetration", series(r.penetration)}}},
+                         {"worked", r.worked}}},
                        {"snapshots", std::move(snapshots)}};
   if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
   if (!r.substeps.is_null()) out["substeps"] = r.substeps;
   if (r.calibration) out["calibration"] = material::calibration_json(*r.calibration);
-  if (!r.penetration_follow.empty()) {
-    out["series"]["penetration_guides"] = series(r.penetration_guides);
-    out["series"]["penetration_follow"] = series(r.penetration_follow);
-  }
+  for (std::size_t c = 0; c < metrics::column_count(); ++c)
+    if (const metrics::Column& col = metrics::column(c); col.reported && !(col.follow_only && r.frame_values[c].empty()))
+      out["series"][std::string(col.name)] = series(r.frame_values[c]);
   if (!r.device.empty()) out["device"] = r.device;
   if (!r.gpu_ms.empty()) out["series"]["gpu_ms"] = series(r.gpu_ms);
   if (!r.gpu_ms_lockstep.empty()) out["series"]["gpu_ms_lockstep"] = series(r.gpu_ms_lockstep);
@@ -401,7 +422,8 @@ nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord
   nlohmann::json j = {{"schema", "hairbench-report"},
                       {"schema_version", 3},
                       {"context", context_json(ctx)},
-                      {"snapshot_encoding", kSnapshotEncoding}};
+                      {"snapshot_encoding", kSnapshotEncoding},
+                      {"metric_definitions", metrics::definitions_json()}};
   j["runs"] = nlohmann::json::array();
   for (const RunRecord& r : runs) {
     const auto sc = std::find_if(scenarios.begin(), scenarios.end(),

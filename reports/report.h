@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.h"
+#include "reports/frame_metrics.h"
 #include "reports/material.h"
 #include "reports/verdict.h"
 
@@ -60,14 +61,14 @@ struct RunRecord {
   // lockstep, between the other models' steps and the metrics (timing.gpu_ms_lockstep).
   std::vector<double> gpu_ms, gpu_ms_lockstep;
   std::optional<double> gpu_clock_mhz;  // the GPU's clock right after the back-to-back steps, where known
-  std::vector<double> deviation;  // NaN where the reference had already failed
-  std::vector<double> jaggedness;
-  std::vector<double> length_rms, length_max;
-  std::vector<double> rest_shape_error;
-  std::vector<double> penetration;
-  // With follow hairs rebuilt from their guides: the guides' and the follow hairs' own
-  // deepest penetration (penetration is the larger); empty otherwise.
-  std::vector<double> penetration_guides, penetration_follow;
+  // The per-frame metrics (reports/frame_metrics.h), one series per column of the table,
+  // in its order: a value per frame run (NaN where the reference had already failed, for
+  // the metrics against it; NaN at the frame the run diverged). A follow-only column is
+  // empty where no follow hairs are rebuilt.
+  std::vector<std::vector<double>> frame_values = std::vector<std::vector<double>>(metrics::column_count());
+  // The series of the column `name` (metrics::column_index; throws std::out_of_range).
+  const std::vector<double>& series(std::string_view name) const { return frame_values[metrics::column_index(name)]; }
+  std::vector<double>& series(std::string_view name) { return frame_values[metrics::column_index(name)]; }
   std::vector<double> t;  // time at the end of each frame
   std::map<std::string, double> stage_ms_total;  // summed over the run
   // Steps in which a stage was not needed and not run; absent when never.

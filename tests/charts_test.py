@@ -359,6 +359,36 @@ def check_sweep(charts_py, data, tmp):
     check(len(unreached) >= 2, "sweep: the diverged runs' final frames are drawn as unreached")
 
 
+def check_metric_table(charts_py, golden, tmp):
+    """The charts draw what the report's metric table holds (metric_definitions): a metric
+    added there, with its series and summary, gets a time-series panel and a table column;
+    a report without the table is refused with one line."""
+    with open(golden) as f:
+        rep = json.load(f)
+    rep["metric_definitions"].append(
+        {"name": "twist", "unit": "1", "meaning": "test metric", "on_device": False, "cli": "",
+         "against_reference": False, "timeseries_label": "twist (test)",
+         "columns": [{"name": "twist", "reported": True, "follow_only": False}],
+         "summaries": [{"key": "max", "column": "twist", "stat": "max", "label": "twist max (test)",
+                        "format": "%.4f", "gate": None}]})
+    for r in rep["runs"]:
+        r["series"]["twist"] = [0.25] * len(r["series"]["t"])
+        r["metrics"]["twist"] = {"max": 0.25}
+    m, stem = run_doctored(charts_py, rep, tmp, "metric_table")
+    for p in m["charts"]["timeseries"]["panels"]:
+        check(p.get("twist") == sum(r["scenario"] == p["scenario"] for r in rep["runs"]),
+              f"metric table: {p['scenario']} has no twist panel with a line per run: {p}")
+    summary = open(f"{stem}_summary.md", encoding="utf-8").read()
+    check("| twist max (test) |" in summary and "| 0.2500 |" in summary, "metric table: no twist column in the summary")
+    del rep["metric_definitions"]
+    bare = os.path.join(tmp, "no_definitions.json")
+    with open(bare, "w") as f:
+        json.dump(rep, f)
+    r = subprocess.run([sys.executable, charts_py, bare], capture_output=True, text=True)
+    check(r.returncode == 2 and r.stderr.count("\n") == 1 and "metric_definitions" in r.stderr,
+          f"a report without metric_definitions: {r.returncode} {r.stderr}")
+
+
 def check_bad(charts_py, tmp):
     """A report the script cannot read: exit 2, one line."""
     bad = os.path.join(tmp, "bad.json")
@@ -379,6 +409,7 @@ def main():
                 tmp)
         guarded("material", check_material, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("deformed", check_deformed, charts_py, os.path.join(data, "compare_report.json"), tmp)
+        guarded("metric table", check_metric_table, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("bad report", check_bad, charts_py, tmp)
         guarded("stress", check_stress, os.path.join(os.path.dirname(charts_py), "stress_chart.py"),
                 os.path.join(data, "stress_small.json"), tmp)

@@ -228,7 +228,7 @@ inline FrameMetrics compare_frame(const metrics::RestInfo& rest, const metrics::
   auto root_metric = [&](const SumBound& b, double count, double scale) {
     return root_bound(b.sum / count, b.bound() / count) / scale + 4.0 * kDoubleU * std::sqrt(b.sum / count) / scale;
   };
-  out["deviation"] = {metrics::deviation(rest, m), metrics::deviation(p, ref, lbar), root_metric(dev, n, lbar)};
+  out["deviation_vs_reference"] = {metrics::deviation(rest, m), metrics::deviation(p, ref, lbar), root_metric(dev, n, lbar)};
   out["rest_shape_error"] = {metrics::rest_shape_error(rest, m), metrics::rest_shape_error(rest, p, in.head),
                              root_metric(shape, n, lbar)};
   out["mechanical_energy"] = {metrics::mechanical_energy(rest, m), metrics::mechanical_energy(p, prev, in.dt, in.gravity),
@@ -239,8 +239,8 @@ inline FrameMetrics compare_frame(const metrics::RestInfo& rest, const metrics::
   const double strands = static_cast<double>(g.strand_count()), jag = metrics::jaggedness(rest, p);
   out["jaggedness"] = {metrics::jaggedness(rest, m), jag, jag_bound / strands + 2.0 * strands * kDoubleU * jag};
   const metrics::LengthError ld = metrics::length_error(rest, m), lh = metrics::length_error(rest, p);
-  out["length_rms"] = {ld.rms, lh.rms, root_metric(len_all, static_cast<double>(rest.edge_count), 1.0)};
-  out["length_max"] = {ld.max, lh.max, len_max_all};
+  out["length_error_rms"] = {ld.rms, lh.rms, root_metric(len_all, static_cast<double>(rest.edge_count), 1.0)};
+  out["length_error_max"] = {ld.max, lh.max, len_max_all};
   // The device's worst edge is a largest one within rounding: its host error is within
   // twice the bound of the host's largest.
   {
@@ -260,6 +260,9 @@ inline FrameMetrics compare_frame(const metrics::RestInfo& rest, const metrics::
                                  metrics::penetration(p.first(gv), spheres), pen_guides};
     out["penetration_follow"] = {metrics::penetration(m.subspan(guide_strands)),
                                  metrics::penetration(p.subspan(gv), spheres), pen_follow};
+    // The groom's: the larger of the two layers'.
+    const MetricPair &pg = out["penetration_guides"], &pf = out["penetration_follow"];
+    out["penetration"] = {std::max(pg.device, pf.device), std::max(pg.host, pf.host), std::max(pg.bound, pf.bound)};
   } else {
     out["penetration"] = {metrics::penetration(m), metrics::penetration(p, spheres), pen_guides};
   }

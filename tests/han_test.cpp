@@ -24,7 +24,7 @@ TEST(HanMethods, NoSpuriousMotionAtRest) {
   const auto runs = test::run(sc, kHan, {}, 2, 120);
   for (const RunRecord& r : runs) {
     ASSERT_FALSE(r.failure) << r.model;
-    EXPECT_LT(test::max_of(r.rest_shape_error), 1e-5) << r.model;
+    EXPECT_LT(test::max_of(r.series("rest_shape_error")), 1e-5) << r.model;
   }
 }
 
@@ -46,8 +46,8 @@ TEST(HanMethods, ReturnToRestShapeAfterRigidJump) {
   const auto runs = test::run(sc, kHan, {{"*", "global_stiffness", 0.0}}, 2, 240);
   for (const RunRecord& r : runs) {
     ASSERT_FALSE(r.failure) << r.model;
-    EXPECT_GT(test::max_of(r.rest_shape_error), 0.05) << r.model << ": the jump should disturb the hair";
-    EXPECT_LT(r.rest_shape_error.back(), 1e-3) << r.model;
+    EXPECT_GT(test::max_of(r.series("rest_shape_error")), 0.05) << r.model << ": the jump should disturb the hair";
+    EXPECT_LT(r.series("rest_shape_error").back(), 1e-3) << r.model;
   }
 }
 
@@ -60,7 +60,7 @@ TEST(HanMethods, QuietStart) {
   Scenario sc = builtin("idle");
   const auto runs = test::run(sc, {"han_m1"}, {}, 2, 60);
   const RunRecord& r = test::find(runs, "han_m1");
-  EXPECT_LT(test::max_of(r.rest_shape_error), 0.02);
+  EXPECT_LT(test::max_of(r.series("rest_shape_error")), 0.02);
 }
 
 // §6: "Method 2 can be as smooth as method 1 if a high number of iterations is used":
@@ -78,11 +78,11 @@ TEST(HanMethods, Method2ConvergesToMethod1WithIterations) {
     setting.push_back({"*", "local_iterations", double(it)});
     const auto runs = test::run(sc, {"han_m1", "han_m2"}, setting);
     const RunRecord& m2 = test::find(runs, "han_m2");
-    const double rms = test::rms_of(m2.deviation);
+    const double rms = test::rms_of(m2.series("deviation_vs_reference"));
     RecordProperty("rms_" + std::to_string(it), std::to_string(rms));
-    RecordProperty("final_" + std::to_string(it), std::to_string(m2.deviation.back()));
+    RecordProperty("final_" + std::to_string(it), std::to_string(m2.series("deviation_vs_reference").back()));
     EXPECT_LT(rms, last_rms) << "local_iterations " << it;
-    EXPECT_LT(m2.deviation.back(), 1e-3) << "local_iterations " << it;
+    EXPECT_LT(m2.series("deviation_vs_reference").back(), 1e-3) << "local_iterations " << it;
     if (it == 1) first_rms = rms;
     last_rms = rms;
   }
@@ -117,8 +117,8 @@ TEST(HanMethods, Method2OnCurlyGroom) {
       const std::string at = std::string(name) + " local_iterations " + std::to_string(it);
       EXPECT_EQ(m2.verdict.status, verdict::Status::ok) << at << ": " << m2.verdict.reason;
       EXPECT_EQ(m3.verdict.status, verdict::Status::ok) << at << ": " << m3.verdict.reason;
-      EXPECT_LE(test::rms_of(m2.deviation), test::rms_of(m3.deviation)) << at;
-      EXPECT_LE(test::mean_of(m2.jaggedness), test::mean_of(m3.jaggedness)) << at;
+      EXPECT_LE(test::rms_of(m2.series("deviation_vs_reference")), test::rms_of(m3.series("deviation_vs_reference"))) << at;
+      EXPECT_LE(test::mean_of(m2.series("jaggedness")), test::mean_of(m3.series("jaggedness"))) << at;
     }
   }
 }
@@ -200,7 +200,7 @@ TEST(HanMethods, Method2AtRestAcrossRoundingSizedRestEdges) {
   RecordProperty("settle_rate", std::to_string(m2.verdict.settle.rate));
   EXPECT_LT(m2.verdict.settle.rate, -10.0);
   EXPECT_LT(m2.verdict.settle.energy_second, 1e-9);
-  EXPECT_NEAR(m2.rest_shape_error.back(), without.rest_shape_error.back(), 1e-5);
+  EXPECT_NEAR(m2.series("rest_shape_error").back(), without.series("rest_shape_error").back(), 1e-5);
   EXPECT_EQ(m2.state_hash, test::find(tiny_runs, "han_m2_ref").state_hash);
 }
 
@@ -208,9 +208,9 @@ TEST(HanMethods, Method2AtRestAcrossRoundingSizedRestEdges) {
 // strands": jaggedness ordering with Table 2's iteration counts (2 length, 3 local).
 TEST(HanMethods, JaggednessOrderingOnShake) {
   const auto runs = test::run(builtin("shake"), kHan, test::paper_setting());
-  const double j1 = test::mean_of(test::find(runs, "han_m1").jaggedness);
-  const double j2 = test::mean_of(test::find(runs, "han_m2").jaggedness);
-  const double j3 = test::mean_of(test::find(runs, "han_m3").jaggedness);
+  const double j1 = test::mean_of(test::find(runs, "han_m1").series("jaggedness"));
+  const double j2 = test::mean_of(test::find(runs, "han_m2").series("jaggedness"));
+  const double j3 = test::mean_of(test::find(runs, "han_m3").series("jaggedness"));
   EXPECT_LE(j1, j2);
   EXPECT_LE(j2, j3);
 }
@@ -222,9 +222,9 @@ TEST(HanMethods, GlobalStiffnessOneFreezesZeroFrees) {
   const auto frozen = test::run(sc, kHan, {{"*", "global_stiffness", 1.0}, {"*", "global_range", 1.0}, {"*", "global_ramp", 0}});
   // Frozen to rounding, method 2 included: its transforms, kept relative to the head, are
   // exact for hair that the head carries rigidly, although they are an iteration old.
-  for (const RunRecord& r : frozen) EXPECT_LT(test::max_of(r.rest_shape_error), 1e-6) << r.model;
+  for (const RunRecord& r : frozen) EXPECT_LT(test::max_of(r.series("rest_shape_error")), 1e-6) << r.model;
   const auto free = test::run(sc, kHan, {{"*", "global_stiffness", 0.0}, {"*", "local_stiffness", 0.0}});
-  for (const RunRecord& r : free) EXPECT_GT(test::max_of(r.rest_shape_error), 0.1) << r.model;
+  for (const RunRecord& r : free) EXPECT_GT(test::max_of(r.series("rest_shape_error")), 0.1) << r.model;
 }
 
 // Edge length constraints keep strands inextensible (< 1% RMS) and collision handling
@@ -234,8 +234,8 @@ TEST(HanMethods, LengthErrorAndNoPenetration) {
     const auto runs = test::run(builtin(name), kHan);
     for (const RunRecord& r : runs) {
       ASSERT_FALSE(r.failure) << name << " " << r.model;
-      EXPECT_LT(test::rms_of(r.length_rms), 0.01) << name << " " << r.model;
-      EXPECT_LT(test::max_of(r.penetration), 1e-5) << name << " " << r.model;
+      EXPECT_LT(test::rms_of(r.series("length_error_rms")), 0.01) << name << " " << r.model;
+      EXPECT_LT(test::max_of(r.series("penetration")), 1e-5) << name << " " << r.model;
     }
   }
 }

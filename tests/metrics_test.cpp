@@ -14,6 +14,8 @@
 #include <cfloat>
 #include <cmath>
 #include <filesystem>
+#include <set>
+#include <stdexcept>
 #include <tuple>
 
 namespace hairbench {
@@ -489,14 +491,83 @@ TEST(Report, NonFiniteValuesBecomeNull) {
   r.vertices = 10;
   r.step_ms = {1.0};
   r.t = {0.1};
-  r.deviation = {std::nan("")};
-  r.jaggedness = {INFINITY};
-  r.length_rms = r.length_max = r.rest_shape_error = r.penetration = {0.0};
+  r.series("deviation_vs_reference") = {std::nan("")};
+  r.series("jaggedness") = {INFINITY};
+  r.series("length_error_rms") = r.series("length_error_max") = r.series("rest_shape_error") = r.series("penetration") = {0.0};
   const std::string text = run_json(r).dump();
   EXPECT_EQ(text.find("NaN"), std::string::npos);
   EXPECT_EQ(text.find("nan"), std::string::npos);
   EXPECT_EQ(text.find("inf"), std::string::npos);
   EXPECT_TRUE(run_json(r)["metrics"]["jaggedness"]["max"].is_null());
+}
+
+// The metric table (reports/frame_metrics.h) is well formed: unique column names found
+// by name, every summary on one of its metric's columns with a printf format, a headline
+// summary per metric, and every gated summary a number the report writes.
+TEST(MetricTable, WellFormed) {
+  const auto table = metrics::frame_metrics();
+  ASSERT_FALSE(table.empty());
+  std::set<std::string_view> names, columns;
+  std::size_t c = 0;
+  for (std::size_t m = 0; m < table.size(); ++m) {
+    const metrics::FrameMetric& fm = table[m];
+    SCOPED_TRACE(std::string(fm.name));
+    EXPECT_TRUE(names.insert(fm.name).second);
+    EXPECT_TRUE(fm.host != nullptr);
+    EXPECT_FALSE(fm.unit.empty());
+    EXPECT_FALSE(fm.meaning.empty());
+    ASSERT_FALSE(fm.columns.empty());
+    ASSERT_FALSE(fm.summaries.empty());
+    EXPECT_EQ(metrics::first_column(m), c);
+    for (const metrics::Column& col : fm.columns) {
+      EXPECT_TRUE(columns.insert(col.name).second) << col.name;
+      EXPECT_EQ(metrics::column_index(col.name), c);
+      EXPECT_EQ(metrics::column(c).name, col.name);
+      ++c;
+    }
+    for (const metrics::Summary& s : fm.summaries) {
+      EXPECT_LT(s.column, fm.columns.size());
+      EXPECT_EQ(s.format.substr(0, 1), "%");
+      EXPECT_GE(s.gate_rel, 0.0);
+    }
+  }
+  EXPECT_EQ(metrics::column_count(), c);
+  EXPECT_THROW(metrics::column_index("no_such_metric"), std::out_of_range);
+  EXPECT_EQ(metrics::definitions_json().size(), table.size());
+}
+
+// The runner records, and the report writes, what the table holds: each metric under its
+// name with each summary's key, each reported column as a series of a value per frame,
+// and the table itself as metric_definitions.
+TEST(MetricTable, TheReportWritesWhatTheTableHolds) {
+  Scenario sc = load_scenario(find_scenario("shake"));
+  sc.groom = every_nth_strand(sc.groom, 64);
+  sc.frames = 12;
+  sc.settle_from = 0.0;  // every frame is a settled one: rest_shape_error has frames to average
+  ThreadPool pool(2);
+  RunOptions opt;
+  opt.models = {"han_m1", "han_m3"};
+  opt.probe = opt.twin = opt.material_card = false;
+  const std::vector<RunRecord> runs = run_scenario(sc, opt, pool);
+  const nlohmann::json report = make_report(ReportContext{}, runs);
+  EXPECT_EQ(report["metric_definitions"], metrics::definitions_json());
+  for (const nlohmann::json& run : report["runs"]) {
+    for (const metrics::FrameMetric& fm : metrics::frame_metrics()) {
+      const nlohmann::json& m = run["metrics"][std::string(fm.name)];
+      for (const metrics::Summary& s : fm.summaries) {
+        if (fm.columns[s.column].follow_only) continue;  // no follow hairs on `shake`
+        EXPECT_TRUE(s.key.empty() ? m.is_number() : m[std::string(s.key)].is_number()) << fm.name << " " << s.key;
+      }
+      for (const metrics::Column& col : fm.columns) {
+        if (col.reported && !col.follow_only) {
+          EXPECT_EQ(run["series"][std::string(col.name)].size(), 12u) << col.name;
+        }
+      }
+    }
+  }
+  // The reference's deviation from itself is 0; the other's is not.
+  EXPECT_EQ(report["runs"][0]["metrics"]["deviation_vs_reference"]["max"], 0.0);
+  EXPECT_GT(report["runs"][1]["metrics"]["deviation_vs_reference"]["max"].get<double>(), 0.0);
 }
 
 // The card's mode fit (two-pole linear prediction) on sampled decays it must read: a slow

@@ -93,8 +93,17 @@ class SpeedDecisions(unittest.TestCase):
         self.assertEqual(vs[0].verdict, "ok")
 
 
-def report(runs):
-    return {"schema": "hairbench-report", "schema_version": 1, "runs": runs}
+def gated(name, key):
+    return {"name": name, "summaries": [{"key": key, "gate": {"rel": 0.10, "abs": 1e-4}}]}
+
+
+# The shape of hairbench's metric_definitions (reports/frame_metrics.h), its gated summaries.
+DEFINITIONS = [gated("deviation_vs_reference", "rms"), gated("jaggedness", "mean"),
+               gated("length_error", "rms"), gated("rest_shape_error", "")]
+
+
+def report(runs, definitions=DEFINITIONS):
+    return {"schema": "hairbench-report", "schema_version": 1, "runs": runs, "metric_definitions": definitions}
 
 
 def run(model, status="ok", dev=0.01, jag=0.005, length=0.002, rest=0.02):
@@ -120,6 +129,24 @@ class AccuracyDecisions(unittest.TestCase):
     def test_newly_unstable_fails(self):
         self.assertEqual(self.verdicts([run("m")], [run("m", status="unstable")]),
                          ["REGRESSION (no longer ok)"])
+
+    def test_the_candidates_table_decides_what_is_gated(self):
+        # A metric the table gates is checked; one it does not gate is not.
+        base = run("m")
+        base["metrics"]["penetration"] = {"max": 0.001}
+        cand = run("m")
+        cand["metrics"]["penetration"] = {"max": 0.01}
+        plain = perf_gate.judge_accuracy("b", report([base]), "c", report([cand]))
+        self.assertNotIn("penetration.max", [r[1] for r in plain])
+        defs = DEFINITIONS + [gated("penetration", "max")]
+        rows = perf_gate.judge_accuracy("b", report([base]), "c", report([cand], defs))
+        self.assertIn(("penetration.max", "REGRESSION"), [(r[1], r[4]) for r in rows])
+
+    def test_a_candidate_without_the_table_is_an_input_error(self):
+        doc = report([run("m")])
+        del doc["metric_definitions"]
+        with self.assertRaises(perf_gate.GateError):
+            perf_gate.judge_accuracy("b", report([run("m")]), "c", doc)
 
     def test_not_a_report_is_an_input_error(self):
         with self.assertRaises(perf_gate.GateError):

@@ -316,8 +316,8 @@ TEST(PlanteWisp, ReturnsTowardRestShapeAfterHeadStops) {
   const RunRecord& i = test::find(idle, "plante_wisp");
   ASSERT_FALSE(r.failure);
   ASSERT_FALSE(i.failure);
-  EXPECT_LT(r.rest_shape_error.back(), i.rest_shape_error.back() + 0.03);
-  EXPECT_LT(r.rest_shape_error.back(), 0.5 * test::max_of(r.rest_shape_error));
+  EXPECT_LT(r.series("rest_shape_error").back(), i.series("rest_shape_error").back() + 0.03);
+  EXPECT_LT(r.series("rest_shape_error").back(), 0.5 * test::max_of(r.series("rest_shape_error")));
 }
 
 // §4.1 footnote 1, §5.3: a wisp's skeleton has a resolution of its own, its free
@@ -427,8 +427,8 @@ TEST(PlanteWisp, CurlyGroomStaysOkAtRest) {
   const RunRecord& r = test::find(runs, "plante_wisp");
   ASSERT_FALSE(r.failure.has_value());
   EXPECT_EQ(verdict::status_name(r.verdict.status), "ok") << r.verdict.reason;
-  EXPECT_LT(test::max_of(r.length_max), 0.5);
-  EXPECT_LT(r.rest_shape_error.back(), 0.02);
+  EXPECT_LT(test::max_of(r.series("length_error_max")), 0.5);
+  EXPECT_LT(r.series("rest_shape_error").back(), 0.02);
 }
 
 // Finely sampled strands with the head still, under gravity: a generated groom of 32
@@ -458,8 +458,8 @@ TEST(PlanteWisp, FineGroomsStandWithTheHeadStill) {
     const RunRecord& r = test::find(runs, "plante_wisp");
     ASSERT_FALSE(r.failure.has_value());
     EXPECT_EQ(verdict::status_name(r.verdict.status), "ok") << r.verdict.reason;
-    EXPECT_LT(test::max_of(r.length_max), 0.5);
-    EXPECT_LT(test::max_of(r.rest_shape_error), bound);
+    EXPECT_LT(test::max_of(r.series("length_error_max")), 0.5);
+    EXPECT_LT(test::max_of(r.series("rest_shape_error")), bound);
   }
 }
 
@@ -669,7 +669,7 @@ TEST(PlanteWisp, PapersBendingLawRunsTheShakeToAVerdict) {
   ASSERT_FALSE(r.failure.has_value());
   std::printf("bending 0 on shake/8: %s (%s), rest-shape error at the end %.4f\n",
               std::string(verdict::status_name(r.verdict.status)).c_str(), r.verdict.reason.c_str(),
-              r.rest_shape_error.back());
+              r.series("rest_shape_error").back());
   EXPECT_EQ(verdict::status_name(r.verdict.status), "ok") << r.verdict.reason;
 }
 
@@ -725,8 +725,8 @@ TEST(PlanteWisp, FastAgreesWithTheReferenceOnFineAndCurlyGrooms) {
     const RunRecord& fast = test::find(two, "plante_wisp");
     const RunRecord& slow = test::find(two, "plante_wisp_ref");
     ASSERT_FALSE(fast.failure.has_value());
-    ASSERT_EQ(fast.deviation.size(), slow.deviation.size());
-    for (std::size_t f = 0; f < fast.deviation.size(); ++f) ASSERT_EQ(fast.deviation[f], slow.deviation[f]) << "frame " << f;
+    ASSERT_EQ(fast.series("deviation_vs_reference").size(), slow.series("deviation_vs_reference").size());
+    for (std::size_t f = 0; f < fast.series("deviation_vs_reference").size(); ++f) ASSERT_EQ(fast.series("deviation_vs_reference")[f], slow.series("deviation_vs_reference")[f]) << "frame " << f;
     EXPECT_EQ(fast.state_hash, slow.state_hash);
     EXPECT_EQ(test::find(test::run(sc, {"plante_wisp"}, parallel, 1, 90), "plante_wisp").state_hash, slow.state_hash);
   }
@@ -816,8 +816,8 @@ TEST(PlanteWisp, FastAgreesBitForBitWithTheReference) {
   const RunRecord& slow = test::find(ref, "plante_wisp_ref");
   ASSERT_FALSE(fast.failure.has_value());
   EXPECT_EQ(fast.state_hash, slow.state_hash);
-  ASSERT_EQ(fast.deviation.size(), slow.deviation.size());
-  for (std::size_t f = 0; f < fast.deviation.size(); ++f) ASSERT_EQ(fast.deviation[f], slow.deviation[f]) << "frame " << f;
+  ASSERT_EQ(fast.series("deviation_vs_reference").size(), slow.series("deviation_vs_reference").size());
+  for (std::size_t f = 0; f < fast.series("deviation_vs_reference").size(); ++f) ASSERT_EQ(fast.series("deviation_vs_reference")[f], slow.series("deviation_vs_reference")[f]) << "frame " << f;
   const auto one = test::run(sc, {"plante_wisp"}, parallel, 1);
   EXPECT_EQ(one[0].state_hash, slow.state_hash);
 }

@@ -264,10 +264,10 @@ TEST(TressfxScenario, PonytailProjectStaysStableWithHanModels) {
     for (const RunRecord& r : test::run(sc, models)) {
       SCOPED_TRACE(r.model);
       ASSERT_FALSE(r.failure.has_value()) << "frame " << r.failure->frame << ": " << r.failure->reason;
-      ASSERT_EQ(r.length_max.size(), 130u);
+      ASSERT_EQ(r.series("length_error_max").size(), 130u);
       // Stable, and not because nothing happened: the shake swings the hair well away
       // from its head-carried rest shape.
-      EXPECT_GT(test::max_of(r.rest_shape_error), 0.02);
+      EXPECT_GT(test::max_of(r.series("rest_shape_error")), 0.02);
       if (r.model == "plante_wisp") {
         // Its strands are rebuilt inside the wisp envelopes after each step (§5.2), with
         // no constraint on their edges: stretched is a possible verdict, unstable is not.
@@ -278,8 +278,8 @@ TEST(TressfxScenario, PonytailProjectStaysStableWithHanModels) {
       if (!sc.follow) {
         // Every strand simulated: every edge within the stretch limit, and the collision
         // pass, the last stage of each substep, leaves no vertex inside a sphere.
-        EXPECT_LT(test::max_of(r.length_max), verdict::kStretchLimit);
-        EXPECT_LT(test::max_of(r.penetration), 1e-3);
+        EXPECT_LT(test::max_of(r.series("length_error_max")), verdict::kStretchLimit);
+        EXPECT_LT(test::max_of(r.series("penetration")), 1e-3);
       }
     }
   }

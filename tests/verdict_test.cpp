@@ -251,7 +251,7 @@ TEST(Verdict, CascadeOnIdleRestsAndItsFixedReferenceNodesAreUnstable) {
     EXPECT_GT(c.verdict.probe.rate, ProbeSettings::kMinGrowthRate);
     const RunRecord& t = test::find(runs[0][skip], "halen_cascade");
     EXPECT_EQ(t.verdict.status, Status::ok) << t.verdict.reason;
-    EXPECT_LT(*std::max_element(t.rest_shape_error.begin(), t.rest_shape_error.end()), 1e-4);
+    EXPECT_LT(*std::max_element(t.series("rest_shape_error").begin(), t.series("rest_shape_error").end()), 1e-4);
     const RunRecord& m1 = test::find(runs[0][skip], "han_m1");
     EXPECT_EQ(m1.verdict.status, Status::ok) << m1.verdict.reason;
   }
