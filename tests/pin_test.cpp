@@ -6,6 +6,7 @@
 
 #include "core/parallel.h"
 #include "harness/runner.h"
+#include "models/plugin/plugin_models.h"
 #include "models/registry.h"
 
 #include <gtest/gtest.h>
@@ -99,7 +100,9 @@ TEST_P(Pins, EveryPinnedVertexMovesRigidlyWithTheHead) {
   EXPECT_EQ(model->static_strands(), forest ? pg.strands_pinned_twice : 0u);
 }
 
+// The built-in models and the default plugin's (muller_ftl, through the plugin ABI).
 std::vector<std::string> every_model() {
+  plugin::load(HAIRBENCH_FTL_PLUGIN);
   std::vector<std::string> names;
   for (const ModelInfo& m : model_registry()) names.emplace_back(m.name);
   return names;

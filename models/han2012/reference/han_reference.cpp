@@ -160,7 +160,7 @@ void HanModel::substep(const Affine3f& head, const FrameInput& in, const FramePl
   }
 }
 
-std::unique_ptr<HairModel> make_han(Method method, const ModelContext& ctx) {
+std::unique_ptr<HairModel> make_reference(Method method, const ModelContext& ctx) {
   return std::make_unique<HanModel>(method, ctx);
 }
 

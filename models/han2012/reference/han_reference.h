@@ -67,6 +67,6 @@ class HanModel final : public HairModel {
   std::vector<Vec4f> spheres_;             // world-space colliders of the current substep
 };
 
-std::unique_ptr<HairModel> make_han(Method method, const ModelContext& ctx);
+std::unique_ptr<HairModel> make_reference(Method method, const ModelContext& ctx);
 
 }  // namespace hairbench::han

@@ -327,7 +327,7 @@ std::span<const Vec4f> HanVkModel::positions() const {
   return host_pos_;
 }
 
-std::unique_ptr<HairModel> make_han_vk(han::Method method, const ModelContext& ctx) {
+std::unique_ptr<HairModel> make(han::Method method, const ModelContext& ctx) {
   return std::make_unique<HanVkModel>(method, ctx);
 }
 

@@ -76,7 +76,7 @@ class HanVkModel final : public HairModel {
   mutable bool host_current_ = true;
 };
 
-std::unique_ptr<HairModel> make_han_vk(han::Method method, const ModelContext& ctx);
+std::unique_ptr<HairModel> make(han::Method method, const ModelContext& ctx);
 // "" when a Vulkan model can run with ctx.device, else the one-line reason.
 std::string unavailable(const ModelContext& ctx);
 

@@ -265,6 +265,6 @@ void PlanteWispModel::section_points(std::size_t strand, const Eigen::Matrix3f&)
                          &strand_weights_[vb]);
 }
 
-std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx) { return std::make_unique<PlanteWispModel>(ctx); }
+std::unique_ptr<HairModel> make_fused(const ModelContext& ctx) { return std::make_unique<PlanteWispModel>(ctx); }
 
 }  // namespace hairbench::plante

@@ -71,6 +71,6 @@ class PlanteWispModel final : public WispModel {
   std::array<std::atomic<std::int64_t>, 2> sampled_ns_{};
 };
 
-std::unique_ptr<HairModel> make_plante_wisp(const ModelContext& ctx);
+std::unique_ptr<HairModel> make_fused(const ModelContext& ctx);
 
 }  // namespace hairbench::plante

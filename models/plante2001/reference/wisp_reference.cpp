@@ -58,6 +58,6 @@ void PlanteWispRef::section_points(std::size_t strand, const Eigen::Matrix3f& he
   }
 }
 
-std::unique_ptr<HairModel> make_plante_wisp_ref(const ModelContext& ctx) { return std::make_unique<PlanteWispRef>(ctx); }
+std::unique_ptr<HairModel> make_reference(const ModelContext& ctx) { return std::make_unique<PlanteWispRef>(ctx); }
 
 }  // namespace hairbench::plante

@@ -30,6 +30,6 @@ class PlanteWispRef final : public WispModel {
   std::vector<std::vector<std::uint32_t>> thread_mailbox_;
 };
 
-std::unique_ptr<HairModel> make_plante_wisp_ref(const ModelContext& ctx);
+std::unique_ptr<HairModel> make_reference(const ModelContext& ctx);
 
 }  // namespace hairbench::plante
