@@ -114,12 +114,22 @@ struct FollowHairsView {
   std::span<const Vec3f> offsets;                 // per follow vertex: (tangent, normal, binormal) offset
 };
 
+// start_from()'s positions over a model's own: x, y and z from `from`, w kept. Throws
+// std::invalid_argument when the counts differ (the caller gave the wrong layout).
+void start_positions(std::span<const Vec4f> from, std::span<Vec4f> to);
+
 class HairModel {
  public:
   virtual ~HairModel() = default;
   // Takes the rest groom (head rest frame) and the resolved parameters; the hair starts
   // at rest under the identity head transform.
   virtual void reset(const Groom& rest, const ParamSet& params) = 0;
+  // After reset(): the hair starts from `positions` instead, at zero velocity, under the
+  // identity head (a strand kicked into a mode shape, docs/truth.md). They are in the
+  // simulated groom's layout where simulated_groom() is set, else the groom's; their w is
+  // ignored (the rest groom's inverse masses stay). false: the model cannot start from a
+  // given state, and the harness reports so; its state is then as reset() left it.
+  virtual bool start_from(std::span<const Vec4f> /*positions*/) { return false; }
   // Advances by in.dt. Adds per-stage wall times to out_times.
   virtual void step(const FrameInput& in, StageTimes& out_times) = 0;
   // Same topology as the groom given to reset(): strand s, vertex i, world space.

@@ -76,4 +76,13 @@ void ParamSet::scale(std::string_view name, double factor) {
     if (auto it = r.find(name); it != r.end()) it->second *= factor;
 }
 
+void ParamSet::set_chain_limit(const Origin& from) {
+  for (const ParamSpec& p : specs_) {
+    if (p.role == ParamRole::stiffness || p.role == ParamRole::damping)
+      set_everywhere(p.name, 0.0, from);
+    else if (p.role == ParamRole::chain_limit)
+      set_everywhere(p.name, p.chain_value, from);
+  }
+}
+
 }  // namespace hairbench

@@ -61,6 +61,11 @@ class ParamSet {
   // its model runs at (models/halen2007/nodes_model.h).
   void scale(std::string_view name, double factor);
 
+  // The chain limit (docs/truth.md): every `stiffness` and `damping` parameter at 0 and
+  // every `chain_limit` switch at its chain_value, everywhere (region overrides dropped),
+  // so that a hanging strand is a chain under gravity alone.
+  void set_chain_limit(const Origin& from);
+
   bool has(std::string_view name) const;
   const std::map<std::string, double, std::less<>>& base() const { return base_; }
   const std::vector<std::map<std::string, double, std::less<>>>& regions() const { return region_; }

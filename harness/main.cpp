@@ -8,6 +8,7 @@
 #include "harness/gpu_clock.h"
 #include "harness/merge.h"
 #include "harness/plugin_loading.h"
+#include "harness/precision.h"
 #include "harness/progress.h"
 #include "harness/reproduce.h"
 #include "harness/runner.h"
@@ -91,6 +92,15 @@ constexpr const char* kReproduceHelp =
     "testable, each with the paper's sentence) and measurements\n"
     "(hardware-dependent numbers beside the paper's, no verdict).";
 
+constexpr const char* kPrecisionHelp =
+    "precision runs each selected model on one scenario along its\n"
+    "cost knobs (substeps, iterations, node counts, integration\n"
+    "rates) and draws run time against error, log-log, one line\n"
+    "per model: error against the exact answer on a truth\n"
+    "scenario, else against the model's own converged run\n"
+    "(8x every cost knob); writes DIR/precision.json and\n"
+    "DIR/precision.png (docs/precision.md).";
+
 constexpr const char* kScenarioHelp =
     "scenario new writes the scenario that compare --groom runs:\n"
     "a TressFX groom under a built-in motion, with the unit, the\n"
@@ -129,6 +139,24 @@ struct CompareArgs {
   std::optional<KnobSpec> knob;
   PluginLoad plugins;  // what load_plugins loaded and left out, for the report
 };
+
+// --models REGEX, compiled; a bad expression is an input error naming the option.
+std::regex models_regex(const std::string& pattern) {
+  try {
+    return std::regex(pattern);
+  } catch (const std::regex_error& e) {
+    throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
+  }
+}
+
+// Each --set MODEL.NAME=VALUE parsed, checked against the registry and appended.
+void add_sets(const std::vector<std::string>& sets, std::vector<ParamOverride>& out) {
+  for (const std::string& set : sets) {
+    ParamOverride o = parse_param_override(set);
+    check_param_override(o);
+    out.push_back(o);
+  }
+}
 
 // Why `m` does not run in a comparison on `device`, or "" when it does: it needs a device
 // that is missing; and, unless --models names it (`named`), it is a GPU model on a CPU
@@ -203,21 +231,12 @@ void prepare_compare(CompareArgs& a, bool sweep) {
     for (const PresetValue& v : p->values)
       a.run.overrides.push_back({std::string(v.model), std::string(v.param), v.value});
   }
-  for (const std::string& set : a.sets) {
-    ParamOverride o = parse_param_override(set);
-    check_param_override(o);
-    a.run.overrides.push_back(o);
-  }
+  add_sets(a.sets, a.run.overrides);
   if (sweep) {
     if (a.knobs.size() != 1) throw InputError("arguments", "--knob", "give one --knob per sweep");
     a.knob = parse_knob(a.knobs.front());
   }
-  std::regex re;
-  try {
-    re = std::regex(a.models);
-  } catch (const std::regex_error& e) {
-    throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
-  }
+  const std::regex re = models_regex(a.models);
   // Models that need a missing device (no Vulkan): left out with a note by default, an
   // error when --models asked for them.
   for (const ModelInfo& m : model_registry()) {
@@ -520,12 +539,7 @@ struct StressArgs {
 int cmd_stress(StressArgs& a) {
   // The CPU models: the GPU variants run the same algorithms (the agreement tests),
   // and on a CPU Vulkan device a sweep of them would take hours.
-  std::regex re;
-  try {
-    re = std::regex(a.models);
-  } catch (const std::regex_error& e) {
-    throw InputError("arguments", "--models", std::string("bad regular expression: ") + e.what());
-  }
+  const std::regex re = models_regex(a.models);
   for (const ModelInfo& m : model_registry())
     if (m.platform == Platform::Cpu && std::regex_match(std::string(m.name), re)) a.opt.models.emplace_back(m.name);
   if (a.opt.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no CPU model");
@@ -560,6 +574,49 @@ int cmd_stress(StressArgs& a) {
   write_json(file, report);
   std::printf("wrote %s\n", file.string().c_str());
   return a.charts ? draw_charts(file, "stress_chart.py") : 0;
+}
+
+struct PrecisionArgs {
+  std::string scenario;
+  std::string models = ".*";
+  bool models_given = false;
+  std::string reference;  // exact | self; empty: exact on a truth scenario
+  std::vector<std::string> sets;
+  std::size_t keep_every = 0;
+  int frames = 0;
+  int threads = 0;
+  std::string out = "reports/out/precision";
+  bool charts = true;
+};
+
+int cmd_precision(const PrecisionArgs& a) {
+  const Scenario sc = load_scenario(find_scenario(a.scenario));
+  PrecisionOptions o;
+  if (a.reference == "exact") o.reference = PrecisionReference::exact;
+  else if (a.reference == "self") o.reference = PrecisionReference::self;
+  else if (!a.reference.empty()) throw InputError("arguments", "--reference", "'" + a.reference + "' is not exact or self");
+  add_sets(a.sets, o.overrides);
+  const std::regex re = models_regex(a.models);
+  for (const ModelInfo& m : model_registry())
+    if (std::regex_match(std::string(m.name), re) && why_not_run(m, "", a.models_given).empty())
+      o.models.emplace_back(m.name);
+  if (o.models.empty()) throw InputError("arguments", "--models", "'" + a.models + "' matches no model that can run");
+  o.keep_every = a.keep_every;
+  o.frames = a.frames;
+  const bool tty = isatty(fileno(stderr));
+  o.on_run = [tty](const std::string& model, int done, int) {
+    if (tty) std::fprintf(stderr, "\r  precision: %d runs, %-16s", done, model.c_str());
+  };
+  ThreadPool pool(a.threads);
+  const nlohmann::json pr = run_precision(sc, o, pool);
+  if (tty) std::fputc('\n', stderr);
+  std::fputs(precision_table(pr).c_str(), stdout);
+  nlohmann::json report = make_report(ReportContext{pool.threads(), {}}, {});
+  report["precision"] = pr;
+  const std::filesystem::path file = std::filesystem::path(a.out) / "precision.json";
+  write_json(file, report);
+  std::printf("wrote %s\n", file.string().c_str());
+  return a.charts ? draw_charts(file, "precision_chart.py") : 0;
 }
 
 struct MergeArgs {
@@ -824,6 +881,44 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
                         "(a parameter set on the command line is kept)");
 }
 
+void add_precision_options(CLI::App& sub, PrecisionArgs& a) {
+  sub.add_option("--scenario", a.scenario, "built-in scenario or scenario file")->type_name("NAME|PATH")->required();
+  sub.add_option("--models", a.models, "models whose whole name matches (default: every model\na comparison runs)")
+      ->type_name("REGEX")
+      ->each([&a](const std::string&) { a.models_given = true; });
+  sub.add_option("--reference", a.reference,
+                 "exact (a truth scenario's chain; the default there) or\nself (the model at 8x its cost knobs; the "
+                 "default\nelsewhere)")
+      ->type_name("exact|self");
+  sub.add_option("--keep-every", a.keep_every,
+                 "thin the groom to every N-th strand (default: at most 256\nstrands)")
+      ->type_name("N")
+      ->check(whole_number(1, 1'000'000));
+  sub.add_option("--frames", a.frames, "frames per run, 1 to 10000000 (default: the scenario's)")
+      ->type_name("N")
+      ->check(whole_number(1, 10'000'000));
+  add_threads_option(sub, a.threads);
+  sub.add_option("--set", a.sets, "parameter override under the knobs' values; repeatable")
+      ->type_name("MODEL.NAME=VALUE")
+      ->allow_extra_args(false);
+  sub.add_option("--out", a.out, "the report's directory")->type_name("DIR")->capture_default_str();
+  sub.add_flag_callback("--no-charts", [&a] { a.charts = false; }, "write precision.json only");
+}
+
+struct NewScenarioArgs {
+  std::string groom, motion = "shake", unit = "auto", out;
+  std::optional<double> fit_above;
+};
+
+void add_scenario_new_options(CLI::App& sub, NewScenarioArgs& a) {
+  sub.add_option("--groom", a.groom, "a TressFX groom, .tfx or .tfxproj")->type_name("PATH")->required();
+  sub.add_option("--motion", a.motion, "the built-in scenario whose head motion it takes")
+      ->type_name("NAME")
+      ->capture_default_str();
+  add_groom_fit_options(sub, a.unit, a.fit_above);
+  sub.add_option("--out", a.out, "the scenario file to write")->type_name("FILE.json")->required();
+}
+
 void add_stress_options(CLI::App& sub, StressArgs& a) {
   sub.add_option("--models", a.models, "CPU models whose whole name matches (default: all)")->type_name("REGEX");
   sub.add_option("--base", a.opt.base, "the stable starting point: built-in scenario or scenario\nfile")
@@ -926,15 +1021,12 @@ int run(int argc, char** argv) {
   add_merge_options(*merge, merge_args);
   CLI::App* scenario = app.add_subcommand("scenario", kScenarioHelp);
   scenario->require_subcommand(1);
-  std::string new_groom, new_motion = "shake", new_unit = "auto", new_out;
+  NewScenarioArgs new_args;
   CLI::App* scenario_new = scenario->add_subcommand("new", kScenarioHelp);
-  scenario_new->add_option("--groom", new_groom, "a TressFX groom, .tfx or .tfxproj")->type_name("PATH")->required();
-  scenario_new->add_option("--motion", new_motion, "the built-in scenario whose head motion it takes")
-      ->type_name("NAME")
-      ->capture_default_str();
-  std::optional<double> new_fit_above;
-  add_groom_fit_options(*scenario_new, new_unit, new_fit_above);
-  scenario_new->add_option("--out", new_out, "the scenario file to write")->type_name("FILE.json")->required();
+  add_scenario_new_options(*scenario_new, new_args);
+  PrecisionArgs precision_args;
+  CLI::App* precision = app.add_subcommand("precision", kPrecisionHelp);
+  add_precision_options(*precision, precision_args);
 
   std::vector<std::string> tables;
   ReproduceOptions reproduce_opt;
@@ -942,7 +1034,7 @@ int run(int argc, char** argv) {
   CLI::App* reproduce = app.add_subcommand("reproduce", kReproduceHelp);
   add_reproduce_options(*reproduce, tables, reproduce_opt, reproduce_shard);
 
-  for (CLI::App* sub : {list, compare, sweep, stress}) add_plugin_option(*sub, plugin_paths);
+  for (CLI::App* sub : {list, compare, sweep, stress, precision}) add_plugin_option(*sub, plugin_paths);
 
   // Without arguments the usage is the answer, with the exit code of a bad command line;
   // `hairbench help` is a documented spelling of --help.
@@ -956,21 +1048,24 @@ int run(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, -h, --version: printed on stdout
     throw argument_error(app, e);
   }
-  if (list->parsed() || compare->parsed() || sweep->parsed() || stress->parsed())
+  if (list->parsed() || compare->parsed() || sweep->parsed() || stress->parsed() || precision->parsed())
     compare_args.plugins = sweep_args.plugins = load_plugins(plugin_paths);
   if (list->parsed()) return cmd_list(list_what);
   if (compare->parsed()) return run_batches(compare_args, false);
   if (sweep->parsed()) return run_batches(sweep_args, true);
   if (merge->parsed()) return cmd_merge(merge_args);
   if (stress->parsed()) return cmd_stress(stress_args);
-  if (scenario_new->parsed()) return cmd_scenario_new(new_groom, new_motion, new_unit, new_fit_above, new_out);
+  if (scenario_new->parsed())
+    return cmd_scenario_new(new_args.groom, new_args.motion, new_args.unit, new_args.fit_above, new_args.out);
+  if (precision->parsed()) return cmd_precision(precision_args);
   if (reproduce->parsed()) {
     reproduce_opt.papers = select_papers(tables);
     if (!shard_papers(reproduce_opt, reproduce_shard)) return 0;
     return cmd_reproduce(reproduce_opt);
   }
   throw InputError("arguments", "hairbench",
-                   "name a subcommand: list, compare, sweep, stress, merge, reproduce or scenario (see hairbench --help)");
+                   "name a subcommand: list, compare, sweep, stress, merge, reproduce, precision or scenario (see "
+                   "hairbench --help)");
 }
 
 }  // namespace

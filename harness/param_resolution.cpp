@@ -93,6 +93,10 @@ ParamSet resolve_params(const ModelInfo& model, const Scenario& sc, const std::v
     for (const auto& [name, v] : sc.region_params[r])
       if (set.has(name)) set.set_region(r, name, v, {sc.source.string(), "groom.regions." + sc.groom.region_names[r] + "."});
 
+  // A truth scenario runs every model in its chain limit (docs/truth.md), over the
+  // defaults and under what the scenario file and the command line give.
+  if (sc.truth) set.set_chain_limit({sc.source.string(), "truth (chain limit)."});
+
   ParamOverrides base_star, base_model;
   if (auto it = sc.models.find("*"); it != sc.models.end()) {
     check_star_names(sc, it->second);

@@ -30,7 +30,8 @@ ParamOverride parse_param_override(const std::string& arg);
 void check_param_override(const ParamOverride& o);
 
 // One model's parameters for a scenario. Precedence, weakest first: the model's
-// defaults; the groom's region defaults (an asset's .tfxsim); the scenario's "*" then
+// defaults; the groom's region defaults (an asset's .tfxsim); a truth scenario's chain
+// limit (ParamSet::set_chain_limit); the scenario's "*" then
 // its model entry; their "regions" entries; command-line overrides ("*" then the model).
 ParamSet resolve_params(const ModelInfo& model, const Scenario& scenario,
                         const std::vector<ParamOverride>& overrides);

@@ -104,6 +104,9 @@ struct Lane {
   // The nodes a model draws the groom from (HairModel::simulated_groom), whose edges the
   // stretched verdict reads.
   std::optional<metrics::RestInfo> nodes = std::nullopt;
+  // A truth scenario's modal amplitudes (reports/truth.h); unset elsewhere, or where the
+  // model could not be kicked.
+  std::optional<truth::Observer> truth = std::nullopt;
 };
 
 // The lockstep run of one scenario, step by step: make the lanes (the reference first),
@@ -130,6 +133,9 @@ class LockstepRun {
   void stop_diverged(const FrameInput& in, int f, bool driven);
   void measure(const FrameInput& in);
   void track_return(const FrameInput& in);
+  void kick(Lane& l) const;
+  void observe_truth();
+  void fit_truth();
   void snapshot(const FrameInput& in, int f, int frames);
   void record_scenario(int frames) const;
   void time_gpu_lanes();
@@ -139,6 +145,9 @@ class LockstepRun {
 
   const Scenario& sc_;
   const RunOptions& opt_;
+  // When the settle check and the return start. A truth scenario's undamped chain swings
+  // on by design: it has neither (its decay is what the truth fit reads).
+  const double settle_from_ = sc_.truth ? std::numeric_limits<double>::infinity() : sc_.settle_from;
   ThreadPool& pool_;
   const int frames_;
   const metrics::RestInfo rest_;
@@ -223,12 +232,13 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   else if (!opt_.material_card) at_rest.card.skipped_why = "not measured (RunOptions::material_card off)";
   const verdict::Probe& probe = at_rest.probe;
   const auto probed = Clock::now();
-  const bool skip = opt_.skip_inert && !(probe.run && probe.grows);
+  // Truth runs never sleep: a sleeping strand would stop the swing being measured.
+  const bool skip = opt_.skip_inert && !(probe.run && probe.grows) && !sc_.truth;
   // The twin sleeps even under --no-skip: it is the yardstick, not the measured run, and
   // sleeping moves a state by less than 1e-4 L (docs/verdicts.md), a thousandth of the
   // deformed limit. A model whose rest state is unstable never sleeps.
   RestTwin twin;
-  if (opt_.twin) twin = rest_twin(*info, sc_, params, pool_, opt_.device, !(probe.run && probe.grows), frames_);
+  if (opt_.twin && !sc_.truth) twin = rest_twin(*info, sc_, params, pool_, opt_.device, !(probe.run && probe.grows), frames_);
   const auto twinned = Clock::now();
   Lane lane{info, params, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
             metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe, std::move(twin.positions), twin.frames};
@@ -263,7 +273,46 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   lane.prev = sc_.groom.positions;
   const Affine3f h0 = sc_.head.at(0.0);
   for (Vec4f& p : lane.prev) p.head<3>() = h0 * Vec3f(p.head<3>());
+  if (sc_.truth) kick(lane);
   lanes_.push_back(std::move(lane));
+}
+
+// A truth scenario starts the model from its simulated strands kicked into their modes
+// (docs/truth.md), and takes the modal amplitudes at t = 0.
+void LockstepRun::kick(Lane& l) const {
+  RunRecord::Truth t;
+  const Groom& simulated = l.model->simulated_groom() ? *l.model->simulated_groom() : sc_.groom;
+  try {
+    l.truth.emplace(simulated, truth::Kick{sc_.truth->modes, sc_.truth->amplitude, sc_.truth->direction},
+                    sc_.gravity);
+  } catch (const std::invalid_argument& e) {
+    t.skipped_why = e.what();
+  }
+  if (l.truth && !l.model->start_from(l.truth->kicked())) {
+    t.skipped_why = "the model cannot start from a given state (HairModel::start_from)";
+    l.truth.reset();
+  }
+  if (l.truth) {
+    l.truth->add(l.model->simulated_groom() ? l.model->simulated_positions() : l.model->positions());
+    const auto p = l.model->positions();
+    l.prev.assign(p.begin(), p.end());
+  }
+  l.record.truth = std::move(t);
+}
+
+void LockstepRun::observe_truth() {
+  for (Lane& l : lanes_)
+    if (l.running && l.truth) l.truth->add(l.model->simulated_groom() ? l.model->simulated_positions() : l.model->positions());
+}
+
+void LockstepRun::fit_truth() {
+  for (Lane& l : lanes_) {
+    if (!l.truth) continue;
+    if (l.record.failure)
+      l.record.truth->skipped_why = "the run diverged at frame " + std::to_string(l.record.failure->frame);
+    else
+      l.record.truth->strands = l.truth->result(sc_.dt);
+  }
 }
 
 // The reference runs once per scenario: it is lane 0, and it is also the reported run of
@@ -372,7 +421,7 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
         why[i] = metrics::blowup_reason(l.strands);
         if (why[i].empty()) why[i] = l.energy.add(metrics::mechanical_energy(rest_, l.strands), driven);
         l.kinetic = metrics::relative_kinetic_energy(rest_, l.strands, sc_.dt);
-        l.settle.add(in.t, l.kinetic, driven, sc_.settle_from);
+        l.settle.add(in.t, l.kinetic, driven, settle_from_);
         continue;
       }
       const auto p = l.model->positions();
@@ -380,7 +429,7 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
       if (why[i].empty()) why[i] = metrics::blowup_reason(rest_, p, in.head.translation());
       if (why[i].empty()) why[i] = l.energy.add(metrics::mechanical_energy(p, l.prev, sc_.dt, sc_.gravity), driven);
       l.kinetic = verdict::relative_kinetic_energy(p, l.prev, in.head, in.head_prev, sc_.dt);
-      l.settle.add(in.t, l.kinetic, driven, sc_.settle_from);
+      l.settle.add(in.t, l.kinetic, driven, settle_from_);
       l.prev.assign(p.begin(), p.end());
     }
   });
@@ -684,7 +733,8 @@ std::vector<RunRecord> LockstepRun::run() {
     step_lanes(in, driven);
     stop_diverged(in, f, driven);
     measure(in);
-    if (!driven && in.t >= sc_.settle_from - 1e-9) track_return(in);
+    observe_truth();
+    if (!driven && in.t >= settle_from_ - 1e-9) track_return(in);
     snapshot(in, f, frames);
     if (opt_.on_frame) opt_.on_frame(f + 1, frames);
   }
@@ -696,6 +746,7 @@ std::vector<RunRecord> LockstepRun::run() {
 
   for (Lane& l : lanes_) l.record.state_hash = metrics::state_hash(l.model->positions());
   extend_settle(frames);
+  fit_truth();
 
   for (Lane& l : lanes_) {
     RunRecord& r = l.record;
@@ -703,7 +754,8 @@ std::vector<RunRecord> LockstepRun::run() {
     if (r.failure) stop = std::make_pair(r.failure->frame, r.failure->t);
     verdict::Return back = l.back.result();
     back.twin_frames = l.twin_frames;
-    if (l.twin.empty()) back.skipped_why = "no rest twin was run (RunOptions::twin off)";
+    if (sc_.truth) back.skipped_why = "a truth scenario has no settle window (its chain swings on)";
+    else if (l.twin.empty()) back.skipped_why = "no rest twin was run (RunOptions::twin off)";
     r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", stretch_of(l), l.settle.result(),
                                 l.probe, back, sc_.dt);
   }

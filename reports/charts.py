@@ -883,6 +883,49 @@ def overview_html(report):
     return out
 
 
+def truth_html(report):
+    """The truth scenarios' panel (docs/truth.md): per model and truth scenario, each kicked
+    mode's frequency error against the exact chain and its numerical damping (the decay
+    rate σ with every damping term off), beside the model's speed there."""
+    e = html.escape
+    truth_runs = [r for r in report["runs"] if isinstance(r.get("truth"), dict)]
+    if not truth_runs:
+        return []
+    scenarios = list(dict.fromkeys(r["scenario"] for r in truth_runs))
+    out = ["<h2 id='truth'>Truth: the hanging chain</h2>",
+           "<p>Each model in its chain limit (bending and shape terms, damping and gravity compensation off), "
+           "started from strands kicked into the 1st, 2nd and 3rd mode of the chain it simulates, at its default "
+           "step and iterations. Per mode: the frequency error ω/ω<sub>exact</sub> − 1 against the chain's exact "
+           "answer of the chain it simulates (its nodes and their masses), and the numerical damping σ (1/s; the "
+           "exact chain does not decay, &lt; 0 grows); beside them, how far that chain itself is from the "
+           "continuous strand (its resolution's error). "
+           "docs/truth.md gives the derivation and each model's limit.</p>"]
+    for name in scenarios:
+        runs = [r for r in truth_runs if r["scenario"] == name]
+        modes = sorted({m["mode"] for r in runs for m in r["truth"].get("modes", [])})
+        out.append(f"<h3>{e(name)}</h3><table><tr><th>model</th><th>masses</th>"
+                   "<th>its chain vs the continuous strand, mode 1</th>"
+                   + "".join(f"<th>mode {m} error</th>" for m in modes)
+                   + "".join(f"<th>mode {m} σ, 1/s</th>" for m in modes)
+                   + "<th>ns/vertex</th></tr>")
+        for r in runs:
+            t = r["truth"]
+            if "skipped" in t:
+                out.append(f"<tr><td>{e(r['model'])}</td><td colspan='{2 * len(modes) + 3}'>not kicked: "
+                           f"{e(t['skipped'])}</td></tr>")
+                continue
+            by_mode = {m["mode"]: m for m in t["modes"]}
+            masses = ", ".join(sorted({str(m["masses"]) for m in t["modes"]}))
+            err = [fmt(num(by_mode[m]["frequency_error"]), "+.2e") if m in by_mode else "–" for m in modes]
+            sig = [fmt(num(by_mode[m]["sigma"]), ".3g") if m in by_mode else "–" for m in modes]
+            resolution = fmt(num(t["modes"][0].get("resolution_error")), "+.2e")
+            out.append(f"<tr><td>{e(r['model'])}</td><td>{e(masses)}</td><td>{e(resolution)}</td>"
+                       + "".join(f"<td>{e(c)}</td>" for c in err + sig)
+                       + f"<td>{e(fmt(r['timing']['ns_per_vertex'], '.1f'))}</td></tr>")
+        out.append("</table>")
+    return out
+
+
 def write_html(report, path, charts, pareto_by_scenario):
     e = html.escape
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>hairbench report</title><style>",
@@ -894,6 +937,7 @@ def write_html(report, path, charts, pareto_by_scenario):
              "table.overview th{text-align:left}",
              "</style></head><body>", "<h1>hairbench report</h1>", f"<p>{e(context_line(report))}</p>"]
     parts += overview_html(report)
+    parts += truth_html(report)
     parts.append(img_tag(charts["time_vs_error"]["files"][0], "Run time against error (log–log); the Pareto front "
                          "is ringed; runs asleep through a scenario sit on the time axis's floor"))
     parts.append("<h2>Details</h2>")

@@ -11,8 +11,7 @@
 
 namespace hairbench::material {
 
-Mode slowest_mode(std::span<const double> x, double dt, std::size_t first, double floor) {
-  Mode m;
+std::vector<PronyMode> prony_modes(std::span<const double> x, double dt, std::size_t first, double floor) {
   double peak = 0.0;
   for (std::size_t i = first; i < x.size(); ++i) peak = std::max(peak, std::abs(x[i]));
   std::size_t last = first;
@@ -20,7 +19,7 @@ Mode slowest_mode(std::span<const double> x, double dt, std::size_t first, doubl
     if (std::abs(x[i]) > floor * peak) last = i;
   const int n = static_cast<int>(last - first) + 1;
   const int order = std::min(kModeOrder, n / 3);
-  if (!(peak > 0.0) || order < 2) return m;
+  if (!(peak > 0.0) || order < 2) return {};
   Eigen::VectorXd w(n);
   for (int i = 0; i < n; ++i) w[i] = x[first + static_cast<std::size_t>(i)] / peak;
   // Linear prediction w_i = sum_k a_k w_(i-k), least squares; the SVD solve gives the
@@ -47,22 +46,31 @@ Mode slowest_mode(std::span<const double> x, double dt, std::size_t first, doubl
     for (int i = 0; i < n; ++i, p *= z[k]) vander(i, k) = p;
   }
   const Eigen::VectorXcd c = vander.colPivHouseholderQr().solve(w.cast<std::complex<double>>());
-  // Each mode's share of the signal's energy over the window; the slowest (largest |z|)
-  // of those holding at least kModeShare of it.
+  // Each mode's share of the signal's energy over the window.
   std::vector<double> energy(order, 0.0);
   double total = 0.0;
   for (int k = 0; k < order; ++k) {
     for (int i = 0; i < n; ++i) energy[k] += std::norm(c[k] * vander(i, k));
     total += energy[k];
   }
-  int slowest = -1;
-  for (int k = 0; k < order; ++k)
-    if (energy[k] >= kModeShare * total && std::isfinite(std::abs(z[k])) &&
-        (slowest < 0 || std::abs(z[k]) > std::abs(z[slowest])))
-      slowest = k;
-  if (slowest < 0) return m;
-  m.sigma = -std::log(std::abs(z[slowest])) / dt;
-  m.omega = std::abs(std::arg(z[slowest])) / dt;
+  std::vector<PronyMode> out;
+  for (int k = 0; k < order; ++k) {
+    if (!std::isfinite(std::abs(z[k]))) continue;
+    out.push_back({-std::log(std::abs(z[k])) / dt, std::abs(std::arg(z[k])) / dt, total > 0.0 ? energy[k] / total : 0.0});
+  }
+  return out;
+}
+
+// The slowest (largest |z|, smallest sigma) of the modes holding at least kModeShare.
+Mode slowest_mode(std::span<const double> x, double dt, std::size_t first, double floor) {
+  Mode m;
+  const std::vector<PronyMode> modes = prony_modes(x, dt, first, floor);
+  const PronyMode* slowest = nullptr;
+  for (const PronyMode& p : modes)
+    if (p.share >= kModeShare && (!slowest || p.sigma < slowest->sigma)) slowest = &p;
+  if (!slowest) return m;
+  m.sigma = slowest->sigma;
+  m.omega = slowest->omega;
   return m;
 }
 

@@ -47,6 +47,15 @@ struct Mode {
 };
 Mode slowest_mode(std::span<const double> x, double dt, std::size_t first = 0, double floor = 1e-3);
 
+// Every mode Prony's method finds in the window slowest_mode reads (the same fit), with
+// its share of the window's energy; empty where slowest_mode would give NaN. A real
+// oscillation is a conjugate pair, two entries of the same sigma and omega.
+struct PronyMode {
+  double sigma = kNaN, omega = kNaN;
+  double share = 0.0;
+};
+std::vector<PronyMode> prony_modes(std::span<const double> x, double dt, std::size_t first = 0, double floor = 1e-3);
+
 // Each of the card's numbers over the reference's: NaN where either is not finite or the
 // reference's is 0.
 struct Ratios {

@@ -370,6 +370,9 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   if (r.knob) out["knob"] = {{"name", r.knob->name}, {"value", r.knob->value}};
   if (!r.substeps.is_null()) out["substeps"] = r.substeps;
   if (r.calibration) out["calibration"] = material::calibration_json(*r.calibration);
+  if (r.truth)
+    out["truth"] = r.truth->skipped_why.empty() ? nlohmann::json{{"modes", truth::result_json(r.truth->strands)}}
+                                                : nlohmann::json{{"skipped", r.truth->skipped_why}};
   for (std::size_t c = 0; c < metrics::column_count(); ++c)
     if (const metrics::Column& col = metrics::column(c); col.reported && !(col.follow_only && r.frame_values[c].empty()))
       out["series"][std::string(col.name)] = series(r.frame_values[c]);

@@ -5,6 +5,7 @@
 #include "core/types.h"
 #include "reports/frame_metrics.h"
 #include "reports/material.h"
+#include "reports/truth.h"
 #include "reports/verdict.h"
 
 #include <nlohmann/json.hpp>
@@ -51,6 +52,13 @@ struct RunRecord {
   // The run's material card and the reference's on this scenario (reports/material.h).
   material::Card card, reference_card;
   std::optional<material::Calibration> calibration;  // what --calibrate fitted
+  // On a truth scenario (reports/truth.h): each kicked strand's measured mode, or why the
+  // model could not be kicked (skipped_why).
+  struct Truth {
+    std::string skipped_why;
+    std::vector<truth::Observer::StrandResult> strands;
+  };
+  std::optional<Truth> truth;
   // Per frame actually run (a failed run stops early).
   std::vector<double> step_ms;
   // Per frame run: 1 where the model worked (the head moved, wind blew, or some strand was

@@ -7,20 +7,13 @@ usage: reproduce_charts.py REPRODUCE_JSON [OUT_DIR]   (needs matplotlib: Debian'
 python3-matplotlib, i.e. run it with /usr/bin/python3)
 """
 
-import json
 import math
 import os
 import sys
 
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    # Exit code 3 tells hairbench (harness/charts.cpp) to print how to draw it later.
-    print(f"reproduce_charts.py: matplotlib is missing for {sys.executable}: "
-          "install python3-matplotlib and run with /usr/bin/python3", file=sys.stderr)
-    sys.exit(3)
+from chart_support import pyplot, read_report
+
+plt = pyplot("reproduce_charts.py")
 
 
 def draw(chart, verdict, path):
@@ -51,15 +44,7 @@ def draw(chart, verdict, path):
 
 
 def main(argv):
-    if len(argv) < 2:
-        sys.exit(__doc__)
-    path = argv[1]
-    out_dir = argv[2] if len(argv) > 2 else os.path.dirname(os.path.abspath(path))
-    try:
-        with open(path, encoding="utf-8") as f:
-            papers = json.load(f)["papers"]
-    except (OSError, ValueError, KeyError) as e:
-        sys.exit(f"reproduce_charts.py: {path}: not a reproduce report ({e})")
+    papers, out_dir = read_report(argv, "reproduce_charts.py", "papers", "reproduce", __doc__)
     charts = os.path.join(out_dir, "charts")
     os.makedirs(charts, exist_ok=True)
     for p in papers:

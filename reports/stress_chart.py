@@ -7,20 +7,13 @@ usage: stress_chart.py STRESS_JSON [OUT_DIR]   (needs matplotlib: Debian's
 python3-matplotlib, i.e. run it with /usr/bin/python3)
 """
 
-import json
 import os
 import sys
 
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import ListedColormap
-except ImportError:
-    # Exit code 3 tells hairbench (harness/charts.cpp) to print how to draw it later.
-    print(f"stress_chart.py: matplotlib is missing for {sys.executable}: "
-          "install python3-matplotlib and run with /usr/bin/python3", file=sys.stderr)
-    sys.exit(3)
+from chart_support import pyplot, read_report
+
+plt = pyplot("stress_chart.py")
+from matplotlib.colors import ListedColormap  # noqa: E402 (after the backend is chosen)
 
 
 def fmt(v):
@@ -28,15 +21,7 @@ def fmt(v):
 
 
 def main(argv):
-    if len(argv) < 2:
-        sys.exit(__doc__)
-    path = argv[1]
-    out_dir = argv[2] if len(argv) > 2 else os.path.dirname(os.path.abspath(path))
-    try:
-        with open(path, encoding="utf-8") as f:
-            stress = json.load(f)["stress"]
-    except (OSError, ValueError, KeyError) as e:
-        sys.exit(f"stress_chart.py: {path}: not a stress report ({e})")
+    stress, out_dir = read_report(argv, "stress_chart.py", "stress", "stress", __doc__)
 
     axes = stress["axes"]
     degenerate = stress["degenerate"]

@@ -20,8 +20,8 @@ using Vec3d = Eigen::Vector3d;
 constexpr double kPi = std::numbers::pi;
 
 // In the order of enum Style.
-constexpr std::array<std::string_view, 4> kStyles{"straight", "wavy", "curly", "ponytail"};
-enum class Style { Straight, Wavy, Curly, Ponytail };
+constexpr std::array<std::string_view, 5> kStyles{"straight", "wavy", "curly", "ponytail", "hanging"};
+enum class Style { Straight, Wavy, Curly, Ponytail, Hanging };
 
 constexpr double kMaxLength = 100.0;  // metres
 
@@ -202,6 +202,20 @@ std::vector<Vec3f> grow_strand(const GroomSpec& spec, Style style, double r, con
   return points;
 }
 
+// The hanging chains of the truth scenarios (docs/truth.md): strand s rooted under the
+// head at r (0, -cos a_s, sin a_s), its roots 3 cm apart along z (closer when that would
+// not fit under the head), and straight down (-y) in equal edges, so that under gravity
+// along -y it hangs at rest with its free vertices a chain below the pinned vertex 1.
+std::vector<Vec3f> hanging_strand(const GroomSpec& spec, double r, int s, int n) {
+  const double spacing = std::min(0.03, 1.6 * r / spec.strands);
+  const double z = (s - 0.5 * (spec.strands - 1)) * spacing;
+  const double edge = spec.length / (n - 1);
+  std::vector<Vec3f> points;
+  for (int i = 0; i < n; ++i) points.emplace_back(0.0f, static_cast<float>(-std::sqrt(r * r - z * z) - i * edge),
+                                                  static_cast<float>(z));
+  return points;
+}
+
 // Per-region defaults from the TressFX ponytail sample's .tfxsim files (damping, local
 // and global stiffness, global range): front takes the stiffest set (back.tfxsim), top
 // front_top.tfxsim's, tail tail.tfxsim's - a stiff front, a softer top, a loose tail.
@@ -283,7 +297,10 @@ GeneratedGroom generate_groom(const GroomSpec& spec, float head_radius, const st
     const Comb comb = ponytail ? ponytail_comb(root, r, rng) : loose_comb(root);
     const double phase = 2.0 * kPi * rng.uniform();
     const int n = static_cast<int>((s + 1) * total / strands - s * total / strands);
-    out.groom.add_strand(grow_strand(spec, style, r, root, comb, phase, n), comb.region);
+    if (style == Style::Hanging)
+      out.groom.add_strand(hanging_strand(spec, r, static_cast<int>(s), n), 0);
+    else
+      out.groom.add_strand(grow_strand(spec, style, r, root, comb, phase, n), comb.region);
   }
   validate_groom(out.groom, source);
   return out;

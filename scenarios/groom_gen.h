@@ -18,7 +18,7 @@ inline constexpr int kMaxGroomStrands = 1'000'000;
 inline constexpr int kMaxStrandVertices = 256;
 
 struct GroomSpec {
-  std::string style = "straight";  // straight | wavy | curly | ponytail
+  std::string style = "straight";  // straight | wavy | curly | ponytail | hanging
   int strands = 2000;
   int vertices_per_strand = 16;
   // > 0: the groom's total vertex count instead of vertices_per_strand; strands get
@@ -46,7 +46,8 @@ std::span<const std::string_view> groom_styles();
 
 // Strands rooted on the upper half of the head sphere (radius head_radius, centre at
 // the origin), growing outward and combed downward, never inside the sphere; vertices 0
-// and 1 pinned (Han & Harada §3.2). Throws InputError(source, "groom.<field>", ...) on
+// and 1 pinned (Han & Harada §3.2). "hanging": straight strands hanging down (-y) from
+// under the head, the truth scenarios' chains. Throws InputError(source, "groom.<field>", ...) on
 // a spec it cannot build.
 GeneratedGroom generate_groom(const GroomSpec& spec, float head_radius, const std::string& source);
 

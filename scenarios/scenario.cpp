@@ -650,6 +650,52 @@ void read_wind(const Obj& top, Scenario& sc) {
   check_increasing(r, sc.wind.keys, o.key("keys"));
 }
 
+// "truth": the kick of a truth scenario, checked against what the chain's exact answer
+// assumes (docs/truth.md): a still head, nothing but gravity acting, and strands that
+// hang straight along gravity with every vertex past the pinned ones free.
+void read_truth(const Obj& top, Scenario& sc) {
+  if (!top.has("truth")) return;
+  const Reader& r = top.reader();
+  const Obj o(r, top.at("truth"), top.key("truth"), {"modes", "amplitude", "direction"});
+  TruthKick t;
+  for_each_element(o, "modes", [&](const json& j, const std::string& path) {
+    const std::int64_t m = as_integer(r, j, path);
+    if (m < 1 || m > 64) r.fail(path, "must be in [1, 64], got " + std::to_string(m));
+    t.modes.push_back(static_cast<int>(m));
+  });
+  if (t.modes.empty()) r.fail(o.key("modes"), "must list at least one mode");
+  t.amplitude = o.number_or("amplitude", t.amplitude);
+  if (!(t.amplitude > 0.0 && t.amplitude <= 0.05)) r.fail(o.key("amplitude"), "must be in (0, 0.05], got " + num_text(t.amplitude));
+  if (o.has("direction")) t.direction = o.axis("direction");
+  const Vec3f down = sc.gravity.normalized();
+  if (!(sc.gravity.norm() > 0.0f)) r.fail(top.key("gravity"), "a truth scenario needs gravity");
+  if (std::abs(t.direction.dot(down)) > 1e-6f) r.fail(o.key("direction"), "must be horizontal (perpendicular to gravity)");
+  if (!sc.head.keys.empty() || !sc.head.oscillators.empty())
+    r.fail(top.key("head"), "a truth scenario's head holds still (no keys or oscillators)");
+  if (!sc.colliders.empty()) r.fail(top.key("colliders"), "a truth scenario has no colliders");
+  if (sc.wind.ever_active()) r.fail(top.key("wind"), "a truth scenario has no wind");
+  if (sc.follow) r.fail(top.key("groom"), "a truth scenario's strands are simulated whole (no follow hairs)");
+  const Groom& g = sc.groom;
+  for (std::size_t s = 0; s < g.strand_count(); ++s) {
+    const std::string field = "groom: strand " + std::to_string(s);
+    const Vec4f* p = g.positions.data() + g.strand_begin(s);
+    const std::size_t n = g.strand_size(s);
+    std::size_t pinned = 0;
+    while (pinned < n && p[pinned].w() == 0.0f) ++pinned;
+    const std::size_t mode = static_cast<std::size_t>(t.modes[s % t.modes.size()]);
+    if (n - pinned < mode)
+      r.fail(field, "has " + std::to_string(n - pinned) + " free vertices, too few for mode " + std::to_string(mode));
+    const Vec3f pivot = p[pinned - 1].head<3>();
+    for (std::size_t i = pinned; i < n; ++i) {
+      const Vec3f d = p[i].head<3>() - pivot;
+      if (p[i].w() == 0.0f) r.fail(field, "vertex " + std::to_string(i) + " is pinned past the root: not a hanging chain");
+      if ((d - d.dot(down) * down).norm() > 1e-5f * (d.norm() + 1e-6f) || d.dot(down) <= 0.0f)
+        r.fail(field, "vertex " + std::to_string(i) + " is not straight below the last pinned vertex along gravity");
+    }
+  }
+  sc.truth = std::move(t);
+}
+
 // "regions": { region: { name: number } }, for regions the groom has.
 std::map<std::string, std::map<std::string, double>> read_region_overrides(
     const Reader& r, const json& j, const std::string& path, const Groom& groom) {
@@ -723,7 +769,7 @@ namespace {
 Scenario load_scenario_doc(const Reader& r, const json& doc, const fs::path& file) {
   const Obj top(r, doc, "",
                 {"name", "description", "frames", "dt", "gravity", "groom", "head", "colliders", "wind",
-                 "settle_from", "reference", "models"});
+                 "settle_from", "reference", "models", "truth"});
   Scenario sc;
   sc.source = file;
   sc.name = top.string_or("name", file.stem().string());
@@ -746,6 +792,7 @@ Scenario load_scenario_doc(const Reader& r, const json& doc, const fs::path& fil
   sc.reference = top.string_or("reference", sc.reference);
   if (sc.reference.empty()) r.fail(top.key("reference"), "must not be empty");
   read_models(top, sc);
+  read_truth(top, sc);
   return sc;
 }
 

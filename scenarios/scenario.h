@@ -53,6 +53,18 @@ struct GroomImport {
   double seconds_fit = 0.0;  // guessing the unit, fitting the head sphere and the collider
 };
 
+// A truth scenario (docs/truth.md): strands hanging still under gravity, each started in
+// a small multiple of one of its chain's modes, every model in its chain limit
+// (ParamSet::set_chain_limit), never sleeping, the frequency and decay of each mode read
+// from the run (reports/truth.h).
+struct TruthKick {
+  std::vector<int> modes;  // strand s starts in mode modes[s % size()], 1 the slowest
+  // The kick's largest displacement as a fraction of the chain's length (its tip's, in the
+  // slowest mode): small enough that the chain stays linear (docs/truth.md).
+  double amplitude = 1e-3;
+  Vec3f direction = Vec3f::UnitX();  // horizontal, unit
+};
+
 // The model every other is measured against unless a scenario or --reference names
 // another: Han & Harada's method 1, the exact serial transforms (docs/metrics.md).
 inline constexpr const char* kDefaultReference = "han_m1";
@@ -82,6 +94,7 @@ struct Scenario {
   std::string reference = kDefaultReference;
   std::map<std::string, ParamOverrides> models;  // "*" and model names, as in the file
   std::optional<GroomImport> import;              // set for an imported TressFX groom
+  std::optional<TruthKick> truth;
   // Explicit models pick their substeps from the groom when nobody gives a number
   // (harness/substeps.h); stress runs turn that off to escalate a model as it is.
   bool auto_substeps = true;

@@ -65,6 +65,12 @@ std::string scenario_hash(const Scenario& sc, int frames) {
       hash_params(h, values);
     }
   }
+  h.value(sc.truth.has_value());
+  if (sc.truth) {
+    h.value(sc.truth->modes.size()).bytes(sc.truth->modes.data(), sc.truth->modes.size() * sizeof(int));
+    h.value(sc.truth->amplitude);
+    hash_vec(h, sc.truth->direction);
+  }
   char b[17];
   std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h.digest()));
   return b;

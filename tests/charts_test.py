@@ -244,6 +244,25 @@ def check_stress(stress_py, golden, tmp):
         check(f.read(8) == b"\x89PNG\r\n\x1a\n", "stress_heatmap.png is a PNG")
 
 
+def check_precision(precision_py, golden, tmp):
+    """The `hairbench precision` diagram: a PNG next to the report; a report without its
+    "precision" object is refused in one line."""
+    report = os.path.join(tmp, "precision.json")
+    shutil.copy(golden, report)
+    r = subprocess.run([sys.executable, precision_py, report], capture_output=True, text=True)
+    check(r.returncode == 0, f"precision_chart.py exit {r.returncode}: {r.stderr}")
+    png = os.path.join(tmp, "precision.png")
+    check(os.path.isfile(png) and os.path.getsize(png) > 0, f"missing or empty: {png}")
+    with open(png, "rb") as f:
+        check(f.read(8) == b"\x89PNG\r\n\x1a\n", "precision.png is a PNG")
+    bad = os.path.join(tmp, "not_precision.json")
+    with open(bad, "w", encoding="utf-8") as f:
+        json.dump({"runs": []}, f)
+    r = subprocess.run([sys.executable, precision_py, bad], capture_output=True, text=True)
+    check(r.returncode != 0 and "not a precision report" in r.stderr and r.stderr.count("\n") == 1,
+          f"a report without precision: exit {r.returncode}, {r.stderr!r}")
+
+
 def check_asleep(charts_py, golden, tmp):
     """A scenario where one model sleeps (1e-5 ms a step) and another takes 4 ms: the time
     axis is not stretched over the sleeper's decades and its labels stay apart."""
@@ -304,6 +323,30 @@ def check_deformed(charts_py, golden, tmp):
     check(all(p["model"] != run["model"] for p in panel["pareto"]), f"deformed: {run['model']} on the Pareto front")
     page = open(f"{stem}.html", encoding="utf-8").read()
     check("background:#dcc3ee'><b>deformed" in page, "deformed: the overview cell is not lilac with its class")
+
+
+def check_truth(charts_py, golden, tmp):
+    """The truth panel (docs/truth.md): each run's kicked modes' frequency error and decay
+    rate in its own table beside its speed, a run that could not be kicked with its reason,
+    and no panel for a report without truth runs."""
+    with open(golden) as f:
+        rep = json.load(f)
+    m, stem = run_doctored(charts_py, rep, tmp, "no_truth")
+    check("Truth: the hanging chain" not in open(f"{stem}.html", encoding="utf-8").read(),
+          "truth: a panel without truth runs")
+    kicked, skipped = rep["runs"][0], rep["runs"][1]
+    kicked["truth"] = {"modes": [
+        {"mode": 1, "strands": 1, "masses": 6, "exact_omega": 7.82, "omega": 7.81, "frequency_error": -1.17e-3,
+         "sigma": 0.0848, "damping_ratio": 0.0109, "share": 1.0},
+        {"mode": 2, "strands": 1, "masses": 6, "exact_omega": 18.07, "omega": 18.05, "frequency_error": -9.44e-4,
+         "sigma": 0.453, "damping_ratio": 0.0251, "share": 1.0}]}
+    skipped["truth"] = {"skipped": "the model cannot start from a given state (test)"}
+    m, stem = run_doctored(charts_py, rep, tmp, "truth")
+    page = open(f"{stem}.html", encoding="utf-8").read()
+    check("Truth: the hanging chain" in page, "truth: no panel")
+    panel = page[page.index("Truth: the hanging chain"):]
+    for text in ("-1.17e-03", "-9.44e-04", "0.0848", "0.453", "not kicked: the model cannot start from a given state"):
+        check(text in panel, f"truth: {text!r} missing from the panel")
 
 
 def check_material(charts_py, golden, tmp):
@@ -409,10 +452,13 @@ def main():
                 tmp)
         guarded("material", check_material, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("deformed", check_deformed, charts_py, os.path.join(data, "compare_report.json"), tmp)
+        guarded("truth", check_truth, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("metric table", check_metric_table, charts_py, os.path.join(data, "compare_report.json"), tmp)
         guarded("bad report", check_bad, charts_py, tmp)
         guarded("stress", check_stress, os.path.join(os.path.dirname(charts_py), "stress_chart.py"),
                 os.path.join(data, "stress_small.json"), tmp)
+        guarded("precision", check_precision, os.path.join(os.path.dirname(charts_py), "precision_chart.py"),
+                os.path.join(data, "precision_small.json"), tmp)
     for f in failures:
         print("FAILED:", f)
     print(f"{'FAIL' if failures else 'ok'}: charts_test")

@@ -83,7 +83,7 @@ TEST(Cli, HelpNamesEveryOption) {
     std::vector<std::string> names, absent;
   };
   const std::vector<Help> cases = {
-      {"", {"--help", "--version", "list", "compare", "sweep", "stress", "merge", "reproduce"}, {"--frames"}},
+      {"", {"--help", "--version", "list", "compare", "sweep", "stress", "merge", "reproduce", "precision"}, {"--frames"}},
       {"list", {"--help", "models|compared|scenarios|presets|devices", "--plugin"}, {"--out"}},
       {"compare", run_options, {"--knob", "--quick"}},
       {"sweep", sweep_options, {"--quick", "--keep-every"}},
@@ -92,6 +92,10 @@ TEST(Cli, HelpNamesEveryOption) {
         "--plan", "--costs", "--plugin"},
        {"--scenario", "--set", "--knob", "--preset"}},
       {"merge", {"OUT_DIR", "REPORT.json", "--mix-machines", "--no-charts"}, {"--frames", "--models", "--costs", "--plugin"}},
+      {"precision",
+       {"--scenario", "--models", "--reference", "--keep-every", "--frames", "--threads", "--set", "--out",
+        "--no-charts", "--plugin"},
+       {"--knob", "--shard", "--device"}},
       {"reproduce",
        {"han2012", "halen2007", "plante2001", "all", "--frames", "--threads", "--device", "--out", "--shard", "--plan"},
        {"--models", "--set", "--costs", "--plugin"}}};
@@ -254,7 +258,9 @@ TEST(Cli, SweepBadArgumentsExitTwo) {
         "sweep" + sc + " --knob local_iterations=1.5", "sweep" + sc + " --knob =1",
         "sweep" + sc + " --knob local_iterations=1 --knob substeps=2",
         "sweep" + sc + " --knob local_iterations=1 --reference bogus",
-        "compare" + sc + " --knob local_iterations=1"}) {
+        "compare" + sc + " --knob local_iterations=1", std::string("precision --models han_m1"),
+        "precision" + sc + " --reference exact", "precision" + sc + " --reference bogus",
+        "precision" + sc + " --models nosuch", "precision" + sc + " --set han_m1.nosuch=1"}) {
     const hairbench::test::CliResult r = run_cli(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.out;
     EXPECT_EQ(count_lines(r.out), 1) << args << ": " << r.out;

@@ -31,7 +31,7 @@ void* create(const hb_host* host, char* err, size_t err_size) {
   return m;
 }
 
-int reset(void* p, const hb_groom* g, const hb_params* params, const hb_initial_state*, char*, size_t) {
+int reset(void* p, const hb_groom* g, const hb_params* params, const hb_initial_state* initial, char*, size_t) {
   Model& m = *static_cast<Model*>(p);
   m.offsets.assign(g->strand_offsets, g->strand_offsets + g->strand_count + 1);
   m.rest.assign(g->positions, g->positions + 4 * g->vertex_count);
@@ -43,6 +43,10 @@ int reset(void* p, const hb_groom* g, const hb_params* params, const hb_initial_
       const float* b = &m.rest[4 * v];
       m.length[v] = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]));
     }
+  // A kicked start (a truth scenario): these positions, at rest; w stays the groom's.
+  if (initial && initial->positions)
+    for (size_t i = 0; i < 4 * g->vertex_count; ++i)
+      if (i % 4 != 3) m.pos[i] = m.prev[i] = initial->positions[i];
   m.iterations = static_cast<int>(params->base[0]);
   m.damping = static_cast<float>(params->base[1]);
   return HB_OK;

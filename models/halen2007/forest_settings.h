@@ -52,7 +52,8 @@ inline constexpr std::array<ParamSpec, 14> kParams{{
      "simulated nodes per strand (Fig. 6.1.1: 4 and 8); the groom's vertices are drawn from them (§5.5), at most the groom's vertices per strand; joint stiffness and damping are given at 8 nodes and scale as ((nodes - 1) / 7)^2", ParamRole::cost_knob},
     {"joint_stiffness", 1100.0, 0.0, 1e6, false,
      "k of Eq. 4.2.2 at the root, angular acceleration per radian of joint deflection, s^-2", ParamRole::stiffness},
-    {"joint_damping", 26.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1"},
+    {"joint_damping", 26.0, 0.0, 1e4, false, "v of Eq. 4.2.2, angular acceleration per rad/s, s^-1",
+     ParamRole::chain_limit, 0.0},
     {"falloff_exponent", 2, 1, 3, true, "a of §5.9's k_L = k / (L c)^a: 1 linear, 2 quadratic, 3 cubic"},
     {"falloff_scale", 5.0, 0.0, 1e4, false,
      "c of §5.9, 1/m: the strength is k up to L = 1/c from the root, then falls as (L c)^-a"},
@@ -67,7 +68,8 @@ inline constexpr std::array<ParamSpec, 14> kParams{{
     {"substeps", 12, 1, 64, true, "solver passes per frame; the head is interpolated between them", ParamRole::cost_knob},
     {"gravity_compensation", 1, 0, 1, true,
      "1: gravity's torque on the head-transformed rest segment is subtracted, so that pose is in "
-     "equilibrium; 0: §4.2 as written, gravity bends the strand until the joint springs hold it"},
+     "equilibrium; 0: §4.2 as written, gravity bends the strand until the joint springs hold it",
+     ParamRole::chain_limit, 0.0},
     {"inertia", 1, 0, 1, true,
      "J of Eq. 4.2.4 for the external torques: 1 J = m L ℓ (a straight strand swings like a pendulum of "
      "its length ℓ), 0 §4.2's J ≈ mI (angular acceleration L z × a)"},

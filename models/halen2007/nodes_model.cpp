@@ -55,6 +55,12 @@ void NodesModel::reset(const Groom& rest, const ParamSet& given) {
   draw(Affine3f::Identity());
 }
 
+bool NodesModel::start_from(std::span<const Vec4f> positions) {
+  if (!inner_->start_from(positions)) return false;
+  draw(Affine3f::Identity());
+  return true;
+}
+
 void NodesModel::step(const FrameInput& in, StageTimes& out_times) {
   inner_->step(in, out_times);
   const StageTimer timer(out_times, Stage::Interpolate);

@@ -88,6 +88,9 @@ class NodesModel final : public HairModel {
   NodesModel(std::unique_ptr<HairModel> inner, const NodeTraits& traits, const ModelContext& ctx);
   // Lays `rest` out as the parameter `nodes` asks and resets the inner model on the nodes.
   void reset(const Groom& rest, const ParamSet& params) override;
+  // Starts the inner model from node positions (the simulated groom's layout) and draws
+  // the groom's vertices from them.
+  bool start_from(std::span<const Vec4f> positions) override;
   // Steps the inner model, then draws the groom's vertices (stage "interpolate").
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return drawn_; }

@@ -20,7 +20,8 @@ namespace hairbench::han {
 inline constexpr std::array<ParamSpec, 9> kParams{{
     {"damping", 0.03, 0.0, 1.0, false,
      "fraction of velocity removed per (sub)step in Verlet (Halén Eq. 4.1: k = 1 - damping)", ParamRole::damping},
-    {"global_stiffness", 0.2, 0.0, 1.0, false, "S_G of Eq. 2; 1 freezes hair to the rest shape"},
+    {"global_stiffness", 0.2, 0.0, 1.0, false, "S_G of Eq. 2; 1 freezes hair to the rest shape",
+     ParamRole::chain_limit, 0.0},
     {"global_range", 1.0, 0.0, 1.0, false,
      "fraction of each strand, from the root, that the global constraint acts on"},
     {"global_ramp", 1.0, 0.0, 1.0, true,

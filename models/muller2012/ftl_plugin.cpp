@@ -32,10 +32,12 @@ enum Param : std::size_t { kFtlDamping, kDamping, kSubsteps, kParamCount };
 const hb_param_spec kParams[kParamCount] = {
     {"ftl_damping", 0.9, 0.0, 1.0, 0,
      "s_damping (§4, Algorithm 1): the share of the child's FTL correction taken off a vertex's velocity, "
-     "dimensionless; the paper reports 0.9",
-     HB_ROLE_DAMPING, 0.0},
+     "dimensionless; the paper reports 0.9. 1 takes the whole correction off, and the strand then swings as "
+     "a chain of its masses (docs/truth.md): below 1 the correction is a damping of its own and shifts the "
+     "frequencies",
+     HB_ROLE_CHAIN_LIMIT, 1.0},
     {"damping", 0.0, 0.0, 1.0, 0,
-     "plain velocity damping per substep, v *= 1 - damping, dimensionless (ours, not the paper's)", HB_ROLE_NONE,
+     "plain velocity damping per substep, v *= 1 - damping, dimensionless (ours, not the paper's)", HB_ROLE_DAMPING,
      0.0},
     {"substeps", 1.0, 1.0, 64.0, 1,
      "DFTL steps per frame, the head interpolated between the frame's ends, count (the base value; regions ignored)",

@@ -487,7 +487,36 @@ void WispModel::reset(const Groom& rest, const ParamSet& params) {
   strand_points_.assign(pos_.size(), Vec3f::Zero());
   strand_weights_.assign(pos_.size(), 0.0f);
   prepare(threads);
+  set_skeletons(rest);
   rebuild(Affine3f::Identity());
+}
+
+void WispModel::set_skeletons(const Groom& rest) {
+  skeletons_ = Groom{};
+  skeletons_.region_names = rest.region_names;
+  skeletons_.head_radius = rest.head_radius;
+  for (std::size_t w = 0; w < sys_.wisp_count(); ++w) {
+    for (std::uint32_t i = sys_.node_begin[w]; i < sys_.node_begin[w + 1]; ++i) {
+      const Vec3f& p = sys_.rest_x[i];
+      skeletons_.positions.emplace_back(p.x(), p.y(), p.z(), sys_.pinned[i] ? 0.0f : 1.0f / sys_.mass[i]);
+    }
+    skeletons_.strand_offsets.push_back(static_cast<std::uint32_t>(skeletons_.positions.size()));
+    skeletons_.strand_region.push_back(sys_.wisp_params[w]);
+  }
+  skeleton_pos_ = skeletons_.positions;
+}
+
+bool WispModel::start_from(std::span<const Vec4f> positions) {
+  start_positions(positions, skeleton_pos_);
+  for (std::size_t i = 0; i < sys_.x.size(); ++i) {
+    if (!sys_.pinned[i]) sys_.x[i] = skeleton_pos_[i].head<3>();
+    sys_.v[i].setZero();
+  }
+  for (std::size_t i = 0; i < sys_.r.size(); ++i) sys_.r[i] = sys_.r_rest[i / k::kEnvelopePerSection];
+  std::fill(sys_.rdot.begin(), sys_.rdot.end(), 0.0f);
+  for (std::size_t w = 0; w < sys_.wisp_count(); ++w) k::wisp_frames(sys_, w, sys_.rest_e1[w]);
+  rebuild(Affine3f::Identity());
+  return true;
 }
 
 
@@ -630,6 +659,7 @@ void WispModel::step(const FrameInput& in, StageTimes& times) {
 // by the free vertices, fading with the section weight that already blends the axes
 // near the root (root_blend), so the strand stays attached to its root.
 void WispModel::rebuild(const Affine3f& head) {
+  for (std::size_t i = 0; i < sys_.x.size(); ++i) skeleton_pos_[i].head<3>() = sys_.x[i];
   const Eigen::Matrix3f head_rot = head.linear();
   prepare_sections(head_rot);
   auto body = [&](std::size_t begin, std::size_t end) {

@@ -35,6 +35,14 @@ class WispModel : public HairModel {
   // What a step reads and writes: the skeleton's and envelope's state and forces, the
   // section frames, and the rebuilt strands.
   std::size_t state_bytes() const override;
+  // The skeletons are the simulated groom: one strand per wisp, its nodes' rest positions
+  // with w = 1 / the node's mass (0 pinned), their edges the axial springs; the groom's
+  // strands are drawn from them (§3.4).
+  const Groom* simulated_groom() const override { return &skeletons_; }
+  std::span<const Vec4f> simulated_positions() const override { return skeleton_pos_; }
+  // The free nodes at the given positions (the skeletons' layout), every velocity 0, the
+  // envelopes at their rest radii and the sections' frames rebuilt from the skeleton.
+  bool start_from(std::span<const Vec4f> positions) override;
 
   // The simulation state, for tests and inspection. Tests may edit velocities.
   const kernels::WispSystem& wisps() const { return sys_; }
@@ -92,6 +100,8 @@ class WispModel : public HairModel {
   template <class F>
   void for_each(std::size_t count, F&& f);
   void detect_self_interactions();
+  // skeletons_ from the wisps cluster() built.
+  void set_skeletons(const Groom& rest);
 
   ModelContext ctx_;
   Groom rest_;
@@ -108,6 +118,8 @@ class WispModel : public HairModel {
   std::vector<Vec4f> coord_;              // per groom vertex
   std::vector<std::uint32_t> vertex_node_;  // per groom vertex: the node coord_ is relative to
   std::vector<Vec4f> pos_;
+  Groom skeletons_;                  // simulated_groom()
+  std::vector<Vec4f> skeleton_pos_;  // sys_.x, refreshed with every rebuild
   // The rebuild's section point and weight of each vertex (section_points).
   std::vector<Vec3f> strand_points_;
   std::vector<float> strand_weights_;

@@ -69,20 +69,39 @@ class PluginModel final : public HairModel {
     rest_vertices_ = rest.vertex_count();
     own_.assign(rest.positions.begin(), rest.positions.end());
     view_ = own_;
-    if (!model_) return;
-    std::vector<float> rest_xyzw(4 * rest.vertex_count());
+    rest_xyzw_.resize(4 * rest.vertex_count());
     for (std::size_t v = 0; v < rest.vertex_count(); ++v)
-      std::copy(rest.positions[v].data(), rest.positions[v].data() + 4, &rest_xyzw[4 * v]);
-    const hb_groom groom{rest.strand_count(), rest.strand_offsets.data(), rest.vertex_count(), rest_xyzw.data(),
-                         rest.strand_region.data(), rest.region_names.size(), rest.head_radius};
-    std::vector<double> base, regions;
-    for (std::size_t i = 0; i < desc_.param_count; ++i) base.push_back(params.get(desc_.params[i].name));
+      std::copy(rest.positions[v].data(), rest.positions[v].data() + 4, &rest_xyzw_[4 * v]);
+    offsets_ = rest.strand_offsets;
+    strand_region_ = rest.strand_region;
+    groom_ = {rest.strand_count(), offsets_.data(), rest.vertex_count(), rest_xyzw_.data(),
+              strand_region_.data(), rest.region_names.size(), rest.head_radius};
+    base_.clear();
+    region_values_.clear();
+    for (std::size_t i = 0; i < desc_.param_count; ++i) base_.push_back(params.get(desc_.params[i].name));
     for (std::size_t r = 0; r < rest.region_names.size(); ++r)
-      for (std::size_t i = 0; i < desc_.param_count; ++i) regions.push_back(params.get(desc_.params[i].name, r));
-    const hb_params p{desc_.param_count, base.data(), rest.region_names.size(), regions.data()};
-    char err[kErrorSize] = {};
-    if (guarded("reset", err, [&] { return desc_.reset(model_, &groom, &p, nullptr, err, sizeof err) == HB_OK; }))
-      fetch_positions();
+      for (std::size_t i = 0; i < desc_.param_count; ++i) region_values_.push_back(params.get(desc_.params[i].name, r));
+    call_reset(nullptr);
+  }
+
+  // The ABI takes an initial state at reset (hb_initial_state): the plugin is reset again
+  // with the rest groom it was given (kept here) and these positions.
+  bool start_from(std::span<const Vec4f> positions) override {
+    if (positions.size() != rest_vertices_) start_positions(positions, own_);  // throws: the wrong layout
+    std::vector<float> xyzw(4 * positions.size());
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      std::copy(positions[v].data(), positions[v].data() + 3, &xyzw[4 * v]);
+      xyzw[4 * v + 3] = rest_xyzw_[4 * v + 3];
+    }
+    const hb_initial_state initial{xyzw.data(), nullptr};
+    call_reset(&initial);
+    // A plugin that ignores the initial state starts at rest, and a truth run would read
+    // its stillness as a result: it says it cannot be kicked instead.
+    if (!failure_.empty() || view_.size() != positions.size()) return false;
+    for (std::size_t v = 0; v < positions.size(); ++v)
+      if ((view_[v].head<3>() - positions[v].head<3>()).norm() > 1e-6f * (1.0f + positions[v].head<3>().norm()))
+        return false;
+    return true;
   }
 
   void step(const FrameInput& in, StageTimes& out_times) override {
@@ -110,6 +129,14 @@ class PluginModel final : public HairModel {
   std::string failure() const override { return failure_; }
 
  private:
+  void call_reset(const hb_initial_state* initial) {
+    if (!model_ || !failure_.empty()) return;
+    const hb_params p{desc_.param_count, base_.data(), groom_.region_count, region_values_.data()};
+    char err[kErrorSize] = {};
+    if (guarded("reset", err, [&] { return desc_.reset(model_, &groom_, &p, initial, err, sizeof err) == HB_OK; }))
+      fetch_positions();
+  }
+
   // Calls into the plugin; false (and the model failed) when it returned an error or threw.
   template <class Call>
   bool guarded(const char* what, const char* err, Call&& call) {
@@ -188,6 +215,12 @@ class PluginModel final : public HairModel {
   hb_host host_{};
   void* model_ = nullptr;
   std::size_t rest_vertices_ = 0;
+  // The groom as the plugin was given it, kept for call_reset.
+  std::vector<float> rest_xyzw_;
+  std::vector<std::uint32_t> offsets_;
+  std::vector<std::uint16_t> strand_region_;
+  hb_groom groom_{};
+  std::vector<double> base_, region_values_;
   std::vector<Vec4f> own_;
   std::span<const Vec4f> view_;
   std::vector<float> spheres_;

@@ -149,6 +149,53 @@ void HalenFusedModel::reset(const Groom& rest, const ParamSet& params) {
   sleep_.reset(rest.strand_count());
 }
 
+bool HalenFusedModel::start_from(std::span<const Vec4f> positions) {
+  start_positions(positions, pos_);
+  if (model_ == Model::Forest) {
+    start_forest();
+    return true;
+  }
+  const bool cascade = model_ == Model::Cascade;
+  for (const BlockInfo& b : blocks_) {
+    float* st = state_.data() + b.state;
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    for (int l = 0; l < W; ++l)
+      for (int i = 0; i < b.n; ++i)
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t at = static_cast<std::size_t>(i) * W + static_cast<std::size_t>(l);
+          st[(soa::PX + c) * rows + at] = pos_[b.offset_of[l] + static_cast<std::size_t>(i)][c];
+          st[(soa::QX + c) * rows + at] = cascade ? 0.0f : st[(soa::PX + c) * rows + at];  // at rest
+        }
+  }
+  return true;
+}
+
+// The forest's joint angles that pose pos_ (forest_rest on it, as the reference does),
+// their rates 0.
+void HalenFusedModel::start_forest() {
+  const auto axes = forest_frame_.parent_x ? k::ForestAxes::ParentX : k::ForestAxes::ParentZ;
+  std::vector<k::Mat3f> frames(pos_.size());
+  std::vector<float> theta(pos_.size()), phi(pos_.size()), lengths(pos_.size());
+  for (std::size_t s = 0; s < strand_begin_.size(); ++s) {
+    const std::size_t b = strand_begin_[s], e = s + 1 < strand_begin_.size() ? strand_begin_[s + 1] : pos_.size();
+    k::forest_rest(std::span<const Vec4f>(pos_).subspan(b, e - b), axes, std::span(frames).subspan(b, e - b),
+                   std::span(theta).subspan(b, e - b), std::span(phi).subspan(b, e - b),
+                   std::span(lengths).subspan(b, e - b));
+  }
+  for (const BlockInfo& b : blocks_) {
+    float* st = state_.data() + b.state;
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    for (int l = 0; l < W; ++l)
+      for (int i = 0; i < b.n; ++i) {
+        const std::size_t at = static_cast<std::size_t>(i) * W + static_cast<std::size_t>(l);
+        const std::size_t v = b.offset_of[l] + static_cast<std::size_t>(i);
+        st[soa::TH * rows + at] = theta[v];
+        st[soa::PH * rows + at] = phi[v];
+        st[soa::DTH * rows + at] = st[soa::DPH * rows + at] = 0.0f;
+      }
+  }
+}
+
 // Fills every block's fields and initial state (the hair at rest), with the per-strand
 // set-up the reference models use.
 void HalenFusedModel::setup_blocks(const Groom& rest, const Setup& setup) {

@@ -27,6 +27,9 @@ class HalenFusedModel final : public HairModel {
  public:
   HalenFusedModel(Model model, const ModelContext& ctx);
   void reset(const Groom& rest, const ParamSet& params) override;
+  // The spring and cascade models' particles at the given positions, at rest; the
+  // forest's joint angles that pose them (start_forest).
+  bool start_from(std::span<const Vec4f> positions) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
   // The blocks' fields and state, and the positions written out.
@@ -74,6 +77,7 @@ class HalenFusedModel final : public HairModel {
   // region_ and substeps_ from the model's settings; what the blocks need returned.
   Setup read_settings(const ParamSet& params, std::size_t regions);
   void setup_blocks(const Groom& rest, const Setup& setup);
+  void start_forest();
   void forest_substeps(const FrameInput& in, float dt);
   void feed_block(const BlockInfo& b, kernels::soa::LineFeed& feed) const;
   void run_thread(int t);

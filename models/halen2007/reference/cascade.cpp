@@ -4,6 +4,8 @@
 #include "kernels/common/strand_kernels.h"
 #include "models/halen2007/cascade_settings.h"
 
+#include <algorithm>
+
 namespace hairbench::halen_cascade {
 
 namespace k = hairbench::kernels;
@@ -39,6 +41,12 @@ void CascadeModel::reset(const Groom& rest, const ParamSet& params) {
   space_ = rest_space_;
   acc_.assign(nv, Vec3f::Zero());
   twist_.assign(nv, 0.0f);
+}
+
+bool CascadeModel::start_from(std::span<const Vec4f> positions) {
+  start_positions(positions, pos_);
+  std::fill(step_.begin(), step_.end(), Vec4f::Zero());
+  return true;
 }
 
 std::size_t CascadeModel::state_bytes() const {

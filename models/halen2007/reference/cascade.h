@@ -25,6 +25,7 @@ class CascadeModel final : public HairModel {
  public:
   explicit CascadeModel(const ModelContext& ctx);
   void reset(const Groom& rest, const ParamSet& params) override;
+  bool start_from(std::span<const Vec4f> positions) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
   // Every per-vertex array a step reads or writes.

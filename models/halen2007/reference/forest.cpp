@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "models/halen2007/forest_settings.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hairbench::halen_forest {
@@ -58,6 +59,22 @@ void ForestModel::reset(const Groom& rest, const ParamSet& params) {
   head_hist_[0] = head_hist_[1] = Affine3f::Identity();
   sleep_.reset(rest.strand_count());
   pose(Affine3f::Identity());
+}
+
+bool ForestModel::start_from(std::span<const Vec4f> positions) {
+  std::vector<Vec4f> given = rest_.positions;
+  start_positions(positions, given);
+  std::vector<k::Mat3f> frames(given.size());
+  std::vector<float> lengths(given.size());
+  for (std::size_t s = 0; s < rest_.strand_count(); ++s) {
+    const std::size_t b = rest_.strand_begin(s), n = rest_.strand_size(s);
+    k::forest_rest(std::span<const Vec4f>(given).subspan(b, n), axes_, std::span(frames).subspan(b, n),
+                   std::span(theta_).subspan(b, n), std::span(phi_).subspan(b, n), std::span(lengths).subspan(b, n));
+  }
+  std::fill(dtheta_.begin(), dtheta_.end(), 0.0f);
+  std::fill(dphi_.begin(), dphi_.end(), 0.0f);
+  pose(Affine3f::Identity());
+  return true;
 }
 
 std::size_t ForestModel::state_bytes() const {

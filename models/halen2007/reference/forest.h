@@ -24,6 +24,9 @@ class ForestModel final : public HairModel {
  public:
   explicit ForestModel(const ModelContext& ctx);
   void reset(const Groom& rest, const ParamSet& params) override;
+  // The joint angles that pose the given polyline (forest_rest on it: its pinned segments
+  // are the rest's, so the root frames are too), their rates 0.
+  bool start_from(std::span<const Vec4f> positions) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
   // Every per-vertex array a step reads or writes.

@@ -36,6 +36,12 @@ void SpringModel::reset(const Groom& rest, const ParamSet& params) {
   ref_.assign(rest.vertex_count(), Vec3f::Zero());
 }
 
+bool SpringModel::start_from(std::span<const Vec4f> positions) {
+  start_positions(positions, pos_);
+  prev_ = pos_;
+  return true;
+}
+
 std::size_t SpringModel::state_bytes() const {
   return (rest_.positions.size() + pos_.size() + prev_.size()) * sizeof(Vec4f) +
          (rest_length_.size() + k_.size() + lift_.size()) * sizeof(float) +

@@ -227,6 +227,19 @@ void HanFusedModel::reset(const Groom& rest, const ParamSet& params) {
   spheres_.reserve(static_cast<std::size_t>(substeps_) * 16 * 4);
 }
 
+bool HanFusedModel::start_from(std::span<const Vec4f> positions) {
+  start_positions(positions, pos_);
+  for (const BlockInfo& b : blocks_) {
+    const std::size_t rows = static_cast<std::size_t>(b.n) * W;
+    float* d = data_.data() + b.offset;
+    for (int l = 0; l < W; ++l)
+      for (int i = 0; i < b.n; ++i)
+        for (int c = 0; c < 3; ++c)
+          d[(soa::QX + c) * rows + static_cast<std::size_t>(i) * W + l] = pos_[b.in_offset[l] + i][c];
+  }
+  return true;
+}
+
 std::size_t HanFusedModel::state_bytes() const {
   return data_.size() * sizeof(float) + pos_.size() * sizeof(Vec4f) + rounding_rows_.size() * sizeof(soa::RoundingRow);
 }

@@ -35,6 +35,9 @@ class HanFusedModel final : public HairModel {
  public:
   HanFusedModel(han::Method method, const ModelContext& ctx);
   void reset(const Groom& rest, const ParamSet& params) override;
+  // Positions and the blocks' previous positions at the given ones; method 2's frames stay
+  // at rest, as the reference's do.
+  bool start_from(std::span<const Vec4f> positions) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
   std::size_t state_bytes() const override;

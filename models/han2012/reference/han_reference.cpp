@@ -64,6 +64,12 @@ void HanModel::for_each_strand(F&& f) {
   });
 }
 
+bool HanModel::start_from(std::span<const Vec4f> positions) {
+  start_positions(positions, pos_);
+  prev_ = pos_;
+  return true;
+}
+
 void HanModel::step(const FrameInput& in, StageTimes& times) {
   const float dt = static_cast<float>(in.dt) / static_cast<float>(substeps_);
   const bool calm = sleep_.begin_step(in, ctx_.skip_inert);

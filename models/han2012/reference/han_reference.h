@@ -23,6 +23,9 @@ class HanModel final : public HairModel {
  public:
   HanModel(Method method, const ModelContext& ctx);
   void reset(const Groom& rest, const ParamSet& params) override;
+  // Positions and previous positions both at the given ones; the frames stay at rest (they
+  // matter only with the shape terms on, which a kicked chain has off).
+  bool start_from(std::span<const Vec4f> positions) override;
   void step(const FrameInput& in, StageTimes& out_times) override;
   std::span<const Vec4f> positions() const override { return pos_; }
   // Every array a frame reads or writes (the roofline's streaming floor).

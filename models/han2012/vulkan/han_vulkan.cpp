@@ -254,6 +254,14 @@ void HanVkModel::reset(const Groom& rest, const ParamSet& params) {
   follow_gpu_ms_.reset();
 }
 
+bool HanVkModel::start_from(std::span<const Vec4f> positions) {
+  if (follow_kernel_) return false;
+  start_positions(positions, host_pos_);  // host_pos_ is reset()'s groom, w included
+  context_->upload(pos_, host_pos_.data(), host_pos_.size() * sizeof(Vec4f));
+  context_->upload(prev_, host_pos_.data(), host_pos_.size() * sizeof(Vec4f));
+  return true;
+}
+
 void HanVkModel::upload_frame(const FrameInput& in) {
   if (in.colliders.size() > HAN_VK_MAX_COLLIDERS)
     throw InputError("colliders", std::to_string(in.colliders.size()),

@@ -33,6 +33,10 @@ class HanVkModel final : public HairModel {
   bool set_follow_hairs(const FollowHairsView& follow) override;
   // Throws InputError for a strand longer than HAN_VK_MAX_STRAND_VERTICES.
   void reset(const Groom& rest, const ParamSet& params) override;
+  // The positions and previous positions uploaded at the given ones (method 2's frames
+  // stay at rest, as the CPU models' do); false where follow hairs are built on the device
+  // (a truth scenario has none).
+  bool start_from(std::span<const Vec4f> positions) override;
   // Uploads the frame's inputs, runs the dispatches and waits for them (stages "upload",
   // "dispatch"; their device time is last_gpu_ms()).
   void step(const FrameInput& in, StageTimes& out_times) override;
