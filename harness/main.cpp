@@ -184,15 +184,7 @@ KnobSpec parse_knob(const std::string& arg) {
   while (pos <= arg.size()) {
     const std::size_t comma = std::min(arg.find(',', pos), arg.size());
     const std::string v = arg.substr(pos, comma - pos);
-    std::size_t used = 0;
-    double x = 0.0;
-    try {
-      x = std::stod(v, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != v.size()) throw InputError("--knob", arg, "'" + v + "' is not a number");
-    if (!std::isfinite(x)) throw InputError("--knob", arg, "value is NaN or infinite");
+    const double x = parse_finite(v, "--knob", arg);
     for (double seen : k.values)
       if (seen == x) throw InputError("--knob", arg, "value '" + v + "' is given twice");
     k.values.push_back(x);
@@ -817,6 +809,13 @@ void add_groom_fit_options(CLI::App& sub, std::string& unit, std::optional<doubl
           ""));
 }
 
+// --frames N: every run's frame count instead of the scenario's (compare, sweep, precision).
+void add_frames_option(CLI::App& sub, int& frames) {
+  sub.add_option("--frames", frames, "frames per run, 1 to 10000000 (default: the scenario's)")
+      ->type_name("N")
+      ->check(whole_number(1, 10'000'000));
+}
+
 void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
   a.out = sweep ? "reports/out/sweep" : "reports/out/latest";
   if (!sweep) {
@@ -853,9 +852,7 @@ void add_run_options(CLI::App& sub, CompareArgs& a, bool sweep) {
                  "scenario's, " + std::string(kDefaultReference) + "); converged: " + std::string(kDefaultReference) +
                      " at the settings\nwhere it is its own converged solution (docs/cli.md)")
       ->type_name("MODEL|converged");
-  sub.add_option("--frames", a.run.frames, "frames per run, 1 to 10000000 (default: the scenario's)")
-      ->type_name("N")
-      ->check(whole_number(1, 10'000'000));
+  add_frames_option(sub, a.run.frames);
   add_threads_option(sub, a.threads);
   sub.add_option("--set", a.sets, "parameter override; MODEL may be * for every model that\nhas NAME; repeatable")
       ->type_name("MODEL.NAME=VALUE")
@@ -894,9 +891,7 @@ void add_precision_options(CLI::App& sub, PrecisionArgs& a) {
                  "thin the groom to every N-th strand (default: at most 256\nstrands)")
       ->type_name("N")
       ->check(whole_number(1, 1'000'000));
-  sub.add_option("--frames", a.frames, "frames per run, 1 to 10000000 (default: the scenario's)")
-      ->type_name("N")
-      ->check(whole_number(1, 10'000'000));
+  add_frames_option(sub, a.frames);
   add_threads_option(sub, a.threads);
   sub.add_option("--set", a.sets, "parameter override under the knobs' values; repeatable")
       ->type_name("MODEL.NAME=VALUE")

@@ -8,22 +8,25 @@
 
 namespace hairbench {
 
+double parse_finite(const std::string& text, const std::string& option, const std::string& arg) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size()) throw InputError(option, arg, "'" + text + "' is not a number");
+  if (!std::isfinite(v)) throw InputError(option, arg, "value is NaN or infinite");
+  return v;
+}
+
 ParamOverride parse_param_override(const std::string& arg) {
   const auto dot = arg.find('.');
   const auto eq = arg.find('=');
   if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 || eq == dot + 1)
     throw InputError("--set", arg, "expected MODEL.NAME=VALUE (MODEL may be *)");
-  const std::string value = arg.substr(eq + 1);
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != value.size()) throw InputError("--set", arg, "'" + value + "' is not a number");
-  if (!std::isfinite(v)) throw InputError("--set", arg, "value is NaN or infinite");
-  return {arg.substr(0, dot), arg.substr(dot + 1, eq - dot - 1), v};
+  return {arg.substr(0, dot), arg.substr(dot + 1, eq - dot - 1), parse_finite(arg.substr(eq + 1), "--set", arg)};
 }
 
 void check_param_override(const ParamOverride& o) {

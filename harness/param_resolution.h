@@ -25,6 +25,8 @@ struct ParamOverride {
 };
 // Parses "MODEL.NAME=VALUE"; throws InputError naming the argument.
 ParamOverride parse_param_override(const std::string& arg);
+// `text` as a finite number, all of it; otherwise an InputError(`option`, `arg`, why).
+double parse_finite(const std::string& text, const std::string& option, const std::string& arg);
 // Checks an override against the registry (the model exists; the parameter exists for
 // it, or for at least one model when MODEL is "*").
 void check_param_override(const ParamOverride& o);

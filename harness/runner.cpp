@@ -74,6 +74,12 @@ void take_snapshot(const Groom& g, std::span<const std::uint32_t> strands, std::
   }
 }
 
+// The positions of the strands a model simulates: its nodes' where it draws the groom
+// from them (HairModel::simulated_groom), else the groom's.
+std::span<const Vec4f> simulated_positions(const HairModel& m) {
+  return m.simulated_groom() ? m.simulated_positions() : m.positions();
+}
+
 // One model stepping through the scenario, with its record and its detectors.
 struct Lane {
   const ModelInfo* info;
@@ -293,7 +299,7 @@ void LockstepRun::kick(Lane& l) const {
     l.truth.reset();
   }
   if (l.truth) {
-    l.truth->add(l.model->simulated_groom() ? l.model->simulated_positions() : l.model->positions());
+    l.truth->add(simulated_positions(*l.model));
     const auto p = l.model->positions();
     l.prev.assign(p.begin(), p.end());
   }
@@ -302,7 +308,7 @@ void LockstepRun::kick(Lane& l) const {
 
 void LockstepRun::observe_truth() {
   for (Lane& l : lanes_)
-    if (l.running && l.truth) l.truth->add(l.model->simulated_groom() ? l.model->simulated_positions() : l.model->positions());
+    if (l.running && l.truth) l.truth->add(simulated_positions(*l.model));
 }
 
 void LockstepRun::fit_truth() {

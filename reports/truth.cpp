@@ -64,15 +64,14 @@ Observer::Observer(const Groom& simulated, const Kick& kick, const Vec3f& gravit
 }
 
 void Observer::add(std::span<const Vec4f> positions) {
-  std::vector<double> x;
   for (std::size_t s = 0; s < strands_.size(); ++s) {
     const Strand& st = strands_[s];
-    x.resize(st.chain.masses.size());
-    for (std::size_t k = 0; k < x.size(); ++k) {
+    x_.resize(st.chain.masses.size());
+    for (std::size_t k = 0; k < x_.size(); ++k) {
       const std::size_t v = st.chain.first + k;
-      x[k] = (positions[v] - rest_[v]).head<3>().cast<double>().dot(direction_.cast<double>());
+      x_[k] = (positions[v] - rest_[v]).head<3>().cast<double>().dot(direction_.cast<double>());
     }
-    q_[s].push_back(chain::modal_amplitude(st.mode, st.chain.masses, x));
+    q_[s].push_back(chain::modal_amplitude(st.mode, st.chain.masses, x_));
   }
 }
 

@@ -78,6 +78,7 @@ class Observer {
   std::vector<Vec4f> rest_, kicked_;
   Vec3f direction_;
   std::vector<std::vector<double>> q_;  // per strand, per frame
+  std::vector<double> x_;               // add()'s scratch: one strand's displacements
 };
 
 // Per mode (the strands kicked in it averaged): mode, masses, exact and measured omega,

@@ -129,7 +129,7 @@ class TruthModels : public ::testing::Test {
 // modes as the model it is the reference of (bit-identical pairs to the bit; the
 // forest's, whose kernel reorders rounding, to 1e-6).
 TEST_F(TruthModels, EveryModelStartsFromTheKick) {
-  for (const std::string& m : {"han_m1", "han_m2", "han_m3", "halen_spring", "halen_cascade", "halen_forest",
+  for (const std::string m : {"han_m1", "han_m2", "han_m3", "halen_spring", "halen_cascade", "halen_forest",
                                "plante_wisp", "muller_ftl"}) {
     SCOPED_TRACE(m);
     const std::vector<Result> r = kicked(m);
@@ -166,7 +166,7 @@ TEST_F(TruthModels, EveryModelStartsFromTheKick) {
 // and below about h = dt / 12 a step's g h^2 is a few hundred ulp of a vertex's height
 // and the rounding takes over (docs/truth.md, "The float floor").
 TEST_F(TruthModels, PositionBasedChainsConvergeToTheChainAtSecondOrder) {
-  for (const std::string& m : {"han_m1", "han_m2", "han_m3", "halen_spring", "halen_cascade", "muller_ftl"}) {
+  for (const std::string m : {"han_m1", "han_m2", "han_m3", "halen_spring", "halen_cascade", "muller_ftl"}) {
     SCOPED_TRACE(m);
     const bool ftl = m == "muller_ftl";
     auto at = [&](int substeps, int iterations) {
