@@ -481,6 +481,7 @@ int run_batches(CompareArgs& a, bool sweep) {
       if (!recorded) {
         print_header(sc, a);
         opt.scenario_record = &records.emplace_back();
+        opt.animation = !sweep;  // a sweep's many runs of a scenario are not played
         recorded = true;
       }
       std::fflush(stdout);

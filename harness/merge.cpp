@@ -1,5 +1,7 @@
 #include "harness/merge.h"
 
+#include "reports/animation.h"
+
 #include "core/error.h"
 #include "harness/reproduce.h"
 #include "harness/shard.h"
@@ -225,6 +227,7 @@ json merge_reports(const std::vector<ShardReport>& in, bool mix_machines) {
                  {"schema_version", in.front().report.value("schema_version", 3)},
                  {"context", merged_context(in)},
                  {"snapshot_encoding", kSnapshotEncoding},
+                 {"animation_encoding", animation::kEncoding},
                  {"metric_definitions", in.front().report.value("metric_definitions", json())}};
   json runs = json::array(), scenario_list = json::array();
   std::set<std::string> listed;
@@ -233,6 +236,16 @@ json merge_reports(const std::vector<ShardReport>& in, bool mix_machines) {
     run["shard"] = in[i].report["shard"]["index"];
     const std::string sc = run["scenario"];
     if (listed.insert(sc).second && scenarios.count(sc)) scenario_list.push_back(*scenarios.at(sc).scenario);
+    // The player draws the kept scenario's strands: a shard whose verdicts named others
+    // recorded other strands, and its runs are left without frames.
+    if (scenarios.count(sc) && run.contains("animation")) {
+      const json& kept = scenarios.at(sc).scenario->value("animation", json());
+      json mine;
+      for (const json& s : in[i].report.value("scenarios", json::array()))
+        if (s.value("name", "") == sc) mine = s.value("animation", json());
+      if (kept.is_null() || mine.is_null() || kept.value("strands", json()) != mine.value("strands", json()))
+        run.erase("animation");
+    }
     runs.push_back(std::move(run));
   }
   report["runs"] = std::move(runs);

@@ -9,6 +9,7 @@
 #include "harness/twin.h"
 #include "harness/roofline.h"
 #include "harness/shard.h"
+#include "reports/animation.h"
 #include "reports/device_metrics.h"
 #include "reports/metrics.h"
 #include "reports/verdict.h"
@@ -113,6 +114,8 @@ struct Lane {
   // A truth scenario's modal amplitudes (reports/truth.h); unset elsewhere, or where the
   // model could not be kicked.
   std::optional<truth::Observer> truth = std::nullopt;
+  // The player's frames (RunOptions::animation).
+  animation::Recorder frames{};
 };
 
 // The lockstep run of one scenario, step by step: make the lanes (the reference first),
@@ -143,6 +146,8 @@ class LockstepRun {
   void observe_truth();
   void fit_truth();
   void snapshot(const FrameInput& in, int f, int frames);
+  void record_animation(const FrameInput& in);
+  void encode_animation();
   void record_scenario(int frames) const;
   void time_gpu_lanes();
   void extend_settle(int frames);
@@ -166,6 +171,12 @@ class LockstepRun {
   StageTimes times_;
   double max_violence_ = -1.0;
   ScenarioRecord::SnapshotFrame violent_frame_, final_frame_;
+  // The player's (RunOptions::animation): its frame stride, the strands it may draw (the
+  // simulated ones: guides where follow hairs are rebuilt) and the head at each frame.
+  const bool animate_ = opt_.animation && opt_.scenario_record;
+  const int anim_stride_ = animation::stride(frames_);
+  const std::size_t anim_candidates_ = sc_.follow ? sc_.guides.strand_count() : sc_.groom.strand_count();
+  std::vector<Affine3f> anim_heads_;
 };
 
 }  // namespace
@@ -280,6 +291,7 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   const Affine3f h0 = sc_.head.at(0.0);
   for (Vec4f& p : lane.prev) p.head<3>() = h0 * Vec3f(p.head<3>());
   if (sc_.truth) kick(lane);
+  if (animate_) lane.frames = animation::Recorder(sc_.groom, anim_candidates_);
   lanes_.push_back(std::move(lane));
 }
 
@@ -582,6 +594,40 @@ void LockstepRun::snapshot(const FrameInput& in, int f, int frames) {
   }
 }
 
+// Every anim_stride_-th frame, every running lane's candidate strands; a device model's
+// positions are read back here, outside its timed step.
+void LockstepRun::record_animation(const FrameInput& in) {
+  anim_heads_.push_back(in.head);
+  for (Lane& l : lanes_)
+    if (l.running) l.frames.add(l.model->positions(), in.head);
+}
+
+// Once the verdicts are in: the strands drawn are the spread ones and each strand a
+// verdict names (the worst stretched edge's, the one holding the most motion that does
+// not settle, the one farthest from its rest twin), the same in every panel.
+void LockstepRun::encode_animation() {
+  ScenarioRecord::Animation a;
+  a.stride = anim_stride_;
+  a.heads = anim_heads_;
+  for (const Lane& l : lanes_)
+    for (animation::Named& n : animation::named_strands(l.record.verdict, l.record.model, anim_candidates_))
+      a.named.push_back(std::move(n));
+  const std::vector<std::uint32_t> strands = animation::drawn_strands(anim_candidates_, a.named);
+  a.strands = strands;
+  for (std::uint32_t s : strands) a.vertices.push_back(animation::picked_vertices(sc_.groom.strand_size(s)));
+  for (Lane& l : lanes_) l.record.animation.emplace();
+  pool_.parallel_for(lanes_.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const animation::Recorder& f = lanes_[i].frames;
+      *lanes_[i].record.animation = {f.frames(), f.encode(strands), false, f.ended()};
+    }
+  });
+  a.reference = *lanes_[0].record.animation;
+  lanes_[0].record.animation->data.clear();
+  lanes_[0].record.animation->same_as_reference = true;
+  opt_.scenario_record->animation = std::move(a);
+}
+
 void LockstepRun::record_scenario(int frames) const {
   ScenarioRecord& out = *opt_.scenario_record;
   out.name = sc_.name;
@@ -742,6 +788,7 @@ std::vector<RunRecord> LockstepRun::run() {
     observe_truth();
     if (!driven && in.t >= settle_from_ - 1e-9) track_return(in);
     snapshot(in, f, frames);
+    if (animate_ && f % anim_stride_ == 0) record_animation(in);
     if (opt_.on_frame) opt_.on_frame(f + 1, frames);
   }
   for (Lane& l : lanes_)
@@ -765,6 +812,7 @@ std::vector<RunRecord> LockstepRun::run() {
     r.verdict = verdict::decide(stop, r.failure ? r.failure->reason : "", stretch_of(l), l.settle.result(),
                                 l.probe, back, sc_.dt);
   }
+  if (animate_) encode_animation();
   // Lane 0 is the reference: every deviation carries its verdict.
   const verdict::Verdict reference = lanes_[0].record.verdict;
   const material::Card reference_card = lanes_[0].record.card;

@@ -35,6 +35,8 @@ struct RunOptions {
   // When set, filled with what the runs share: phases, snapshot frames and strands, and
   // the reference's snapshots.
   ScenarioRecord* scenario_record = nullptr;
+  // With scenario_record: record the frames of report.html's player (reports/animation.h).
+  bool animation = false;
   std::string device;  // GPU models' --device (empty: the default device)
   // Each lane's perturbation probe at rest (harness/probe.h), for the `unstable`
   // verdict; a model whose probe grows never sleeps. Off only where a test or benchmark

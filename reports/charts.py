@@ -2,6 +2,7 @@
 """Charts, a Markdown summary and a self-contained HTML page from a hairbench report.
 
 usage: charts.py REPORT.json [--out-dir DIR] [--svg]
+       charts.py REPORT.json --animate SCENARIO [--out-dir DIR]   (writes STEM_SCENARIO.gif only)
 
 Writes next to the report (or into DIR), STEM being the report's file name without .json:
   STEM_time_vs_error.png        median step time against deviation (log-log), one line per
@@ -16,7 +17,9 @@ Writes next to the report (or into DIR), STEM being the report's file name witho
   STEM_summary.md               the summary tables
   STEM.html                     first an overview (a table of runs by scenarios: verdict, step
                                 time relative to the reference model, deviation, jaggedness,
-                                coloured by deviation), then the time-vs-error chart, then the
+                                coloured by deviation), the truth panel, a motion player per
+                                scenario (reports/player.js, inlined, over the report's
+                                animation frames), then the time-vs-error chart, then the
                                 per-scenario tables and every other chart; PNGs inlined: one file
   STEM_charts.json              manifest of what was drawn (files, series, Pareto points)
 
@@ -39,6 +42,7 @@ import math
 import os
 import sys
 import textwrap
+import zlib
 
 try:
     import matplotlib
@@ -550,6 +554,22 @@ def camera(points, centre):
 B64 = {c: i for i, c in enumerate("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/")}
 
 
+def zigzag_varints(data):
+    """Bytes of LEB128 varints (7 bits a byte, low first, the high bit set while more
+    follow), each a zigzag-mapped signed integer -> (the integers, whether the last varint
+    is whole)."""
+    out = []
+    z = shift = 0
+    for b in data:
+        z |= (b & 0x7F) << shift
+        shift += 7
+        if b & 0x80:
+            continue
+        out.append((z >> 1) ^ -(z & 1))
+        z = shift = 0
+    return out, shift == 0
+
+
 def decode_strand(code, ref=None):
     """A snapshot strand -> [x0, y0, z0, x1, ...] in metres. Schema 1: the list itself;
     schema 2 (reports/report.h, encode_snapshot_strand): base64 of zigzag LEB128 varints,
@@ -565,16 +585,11 @@ def decode_strand(code, ref=None):
     except ValueError as e:
         raise ReportError(f"snapshots: strand {code[:16]!r}: not base64 ({e})")
     q = []
-    z = shift = 0
-    for b in data:
-        z |= (b & 0x7F) << shift
-        shift += 7
-        if b & 0x80:
-            continue
+    residuals, whole = zigzag_varints(data)
+    for r in residuals:
         n = len(q)
-        q.append(((z >> 1) ^ -(z & 1)) + (2 * q[n - 3] - q[n - 6] if n >= 6 else q[n - 3] if n >= 3 else 0))
-        z = shift = 0
-    if shift or len(q) % 3 or (ref is not None and len(ref) != len(q)):
+        q.append(r + (2 * q[n - 3] - q[n - 6] if n >= 6 else q[n - 3] if n >= 3 else 0))
+    if not whole or len(q) % 3 or (ref is not None and len(ref) != len(q)):
         raise ReportError(f"snapshots: strand {code[:16]!r}: truncated, or not as long as the reference's")
     if ref is not None:
         q = [v + round(r / 1e-5) for v, r in zip(q, ref)]
@@ -681,6 +696,211 @@ def chart_strands(report, out_dir, stem, written, svg):
                     "columns": [c[0] for c in columns], "panels": len(collections),
                     "strands_per_panel": [c[1] if c else 0 for c in collections], "max_deviation": vmax})
     return out
+
+
+# --- the motion player -----------------------------------------------------------------
+
+def decode_animation(code, sizes):
+    """A run's animation data (reports/animation.h) -> its frames, each a flat list of
+    integer coordinates in the head's frame (unit_metres each), strand after strand of
+    `sizes[s]` vertices: base64, zlib, zigzag LEB128 varints, each predicted from the same
+    coordinate one frame back plus the move of the vertex before it (in frame 0, from the
+    vertex before it; 0 at a root)."""
+    try:
+        data = zlib.decompress(base64.b64decode(code, validate=True))
+    except (ValueError, zlib.error) as e:
+        raise ReportError(f"animation: data {code[:16]!r}: {e}")
+    root = [v == 0 for n in sizes for v in range(n) for _ in range(3)]
+    per = len(root)
+    q = []
+    residuals, whole = zigzag_varints(data)
+    for r in residuals if per else []:
+        at = len(q)
+        i = at % per
+        if at < per:
+            pred = 0 if root[i] else q[at - 3]
+        else:
+            pred = q[at - per] if root[i] else q[at - per] + q[at - 3] - q[at - per - 3]
+        q.append(r + pred)
+    if not whole or not per or len(q) % per:
+        raise ReportError(f"animation: data {code[:16]!r}: truncated, or not whole frames of its strands")
+    return [q[f:f + per] for f in range(0, len(q), per)]
+
+
+def animation_world(anim, frame_k, flat):
+    """One recorded frame's head-frame integers -> world points [(x, y, z), ...]."""
+    h, u = anim["head"][frame_k], anim["unit_metres"]
+    out = []
+    for j in range(0, len(flat), 3):
+        x, y, z = flat[j] * u, flat[j + 1] * u, flat[j + 2] * u
+        out.append((h[3] * x + h[4] * y + h[5] * z + h[0], h[6] * x + h[7] * y + h[8] * z + h[1],
+                    h[9] * x + h[10] * y + h[11] * z + h[2]))
+    return out
+
+
+def began_text(run):
+    """A panel's second line: the verdict and the frame where it began (a stretched run's
+    first frame over the limit, not its peak)."""
+    v = run.get("verdict") or {}
+    first = (v.get("stretch") or {}).get("first_above")
+    if run["status"] == "stretched" and first is not None:
+        return f"stretched from frame {first}", first
+    if run["status"] == "ok" and (run.get("verdict") or {}).get("frame") is None:
+        return "ok", None
+    return verdict_text(run), v.get("frame")
+
+
+def player_data(report):
+    """What report.html's players read (reports/player.js): per scenario with animation
+    frames, the recorded frames, the head, the strands and every run's panel, the
+    reference's first."""
+    out = []
+    for si, name in enumerate(scenario_names(report)):
+        info = scenario_info(report, name) or {}
+        anim = info.get("animation")
+        if not anim:
+            continue
+        # A run without frames (a merged shard's that drew other strands) says so in its panel.
+        runs = [r for r in report["runs"] if r["scenario"] == name]
+        runs.sort(key=lambda r: not (r.get("animation") or {}).get("same_as_reference", False))
+        named = {n["strand"] for n in anim["named"]}
+        panels = []
+        ref = anim["reference"]
+        if not any((r.get("animation") or {}).get("same_as_reference") for r in runs):  # the reference elsewhere
+            panels.append({"label": f"reference {ref['model']}", "status": "ok",
+                           "verdict": reference_text(runs[0]) if runs else "", "began": None,
+                           "frames": ref["frames"], "data": ref["data"]})
+        for r in runs:
+            a = r.get("animation") or {"frames": 0, "same_as_reference": True}
+            text, began = began_text(r)
+            panels.append({"label": run_label(r), "status": r["status"], "verdict": text, "began": began,
+                           "frames": a["frames"], "data": None if a.get("same_as_reference") else a["data"]})
+        out.append({"id": f"hb-player-{si}", "name": name, "dt": info["dt"], "frameCount": info["frames"],
+                    "stride": anim["stride"], "frames": anim["frames"], "head": anim["head"],
+                    "unit": anim["unit_metres"], "sizes": [len(v) for v in anim["vertices"]],
+                    "named": [s in named for s in anim["strands"]], "headRadius": info["head_radius"],
+                    "meanStrandLength": info["mean_strand_length"],
+                    "reference": {"model": anim["reference"]["model"], "frames": anim["reference"]["frames"],
+                                  "data": anim["reference"]["data"]},
+                    "phases": [{"start": p["start"], "end": p["end"],
+                                "colour": matplotlib.colors.to_hex(PHASE_COLOURS.get(p["kind"], "0.6"))}
+                               for p in info.get("phases", [])],
+                    "panels": panels, "named_why": anim["named"]})
+    return out
+
+
+def player_html(report):
+    """The players' section of report.html: the data as JSON, a block of controls per
+    scenario, and reports/player.js inlined (no network, no library)."""
+    e = html.escape
+    scenarios = player_data(report)
+    if not scenarios:
+        return []
+    lut = [matplotlib.colors.to_hex(plt.get_cmap("viridis")(i / 63)) for i in range(64)]
+    out = ["<h2 id='motion'>Motion</h2>",
+           "<p>Every run of a scenario side by side, the reference first, at the same frame and camera: a few strands "
+           "spread over the groom plus every strand a verdict names (drawn thicker), every "
+           f"{scenarios[0]['stride']}th frame or so (docs/report-schema.md#animation). Strands are coloured by their "
+           "per-vertex deviation from the reference, on a log scale from 10⁻⁴ L̄ (dark) to 1 L̄ (yellow); the "
+           "timeline shades the script's phases and ticks, red, the frame where each run's verdict began.</p>"]
+    for sc in scenarios:
+        why = "; ".join(f"strand {n['strand']} ({n['model']}: {n['why']})" for n in sc.pop("named_why"))
+        out.append(f"<div class='hb-player' id='{sc['id']}'><h3>{e(sc['name'])}</h3>"
+                   "<div class='hb-controls'><button class='hb-play'>play</button> <span class='hb-track'>"
+                   f"<input class='hb-slider' type='range' min='0' max='{len(sc['frames']) - 1}' value='0'>"
+                   "<canvas class='hb-timeline' width='600' height='10'></canvas></span> "
+                   "<select class='hb-speed'><option value='0.25'>¼×</option><option value='0.5'>½×</option>"
+                   "<option value='1' selected>1×</option><option value='2'>2×</option></select> "
+                   "<span class='hb-frame'></span></div><div class='hb-panels'></div>"
+                   f"<p class='hb-named'>{e('Strands named: ' + why) if why else ''}</p></div>")
+    payload = json.dumps({"scenarios": scenarios, "viridis": lut}, separators=(",", ":")).replace("</", "<\\/")
+    out.append(f"<script type='application/json' id='hb-player-data'>{payload}</script>")
+    with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "player.js"), encoding="utf-8") as f:
+        out.append(f"<script>{f.read()}</script>")
+    return out
+
+
+def panel_frames(sc):
+    """Every panel's frames of a player_data() scenario, decoded: [[points per strand]...]."""
+    def strands(flat, k):
+        pts, out, at = animation_world(anim, k, flat), [], 0
+        for n in sc["sizes"]:
+            out.append(pts[at:at + n])
+            at += n
+        return out
+    anim = {"head": sc["head"], "unit_metres": sc["unit"]}
+    ref = decode_animation(sc["reference"]["data"], sc["sizes"])
+    own = [[] if not p["frames"] else ref if p["data"] is None else decode_animation(p["data"], sc["sizes"])
+           for p in sc["panels"]]
+    return [[strands(f, k) for k, f in enumerate(q)] for q in own], [strands(f, k) for k, f in enumerate(ref)]
+
+
+def write_animation(report, name, path):
+    """The player of scenario `name` as a GIF (matplotlib's Pillow writer): the panels side
+    by side, coloured as in the page, at the recorded frames' real rate."""
+    sc = next((s for s in player_data(report) if s["name"] == name), None)
+    if sc is None:
+        have = ", ".join(s["name"] for s in player_data(report)) or "none"
+        raise ReportError(f"--animate {name}: the report has no frames of that scenario (it has: {have})")
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    frames, ref = panel_frames(sc)
+    n = len(frames)
+    cols = min(n, 4)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(1.75 * cols, 1.95 * rows), dpi=72, squeeze=False)
+    r_head, lbar = sc["headRadius"], sc["meanStrandLength"]
+    # The page's view: centred on the head's mean position, the reference's strands and the
+    # head in sight, at most 3 L-bar beyond the head (reports/player.js, Player.load).
+    centre = [sum(h[a] for h in sc["head"]) / len(sc["head"]) for a in range(3)]
+    heads = camera([h[:3] for h in sc["head"]], centre)
+    travel = max(math.hypot(x, y) for x, y in heads)
+    lim = max(max(abs(x), abs(y)) + r_head for x, y in heads)
+    for strands in ref:
+        lim = max([lim] + [max(abs(x), abs(y)) for pts in strands for x, y in camera(pts, centre)])
+    lim = 1.05 * min(lim, r_head + 3 * lbar + travel)
+    cmap = plt.get_cmap("viridis")
+    artists = []
+    for i, ax in enumerate(a for row in axes for a in row):
+        ax.set_axis_off()
+        if i >= n:
+            continue
+        p = sc["panels"][i]
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_aspect("equal")
+        ax.set_title(f"{p['label']}\n{p['verdict']}", fontsize=6)
+        head = Circle((0, 0), r_head, color="0.8", zorder=0)
+        ax.add_patch(head)
+        lc = LineCollection([], linewidths=0.8, cmap=cmap, norm=DEV_NORM)
+        ax.add_collection(lc)
+        artists.append((head, lc))
+    title = fig.suptitle("", fontsize=7)
+
+    def draw(k):
+        for (head, lc), panel in zip(artists, frames):
+            kk = min(k, len(panel) - 1)
+            h = sc["head"][k]
+            (hx, hy), = camera([h[:3]], centre)
+            head.center = (hx, hy)
+            segs, devs = [], []
+            for s, pts in enumerate(panel[kk] if panel else []):
+                refp = ref[kk][s] if kk < len(ref) else pts
+                xy = camera(pts, centre)
+                d = [math.dist(a, b) / lbar for a, b in zip(pts, refp)]
+                for v in range(len(xy) - 1):
+                    segs.append([xy[v], xy[v + 1]])
+                    devs.append(max(0.5 * (d[v] + d[v + 1]), 1e-4))
+            lc.set_segments(segs)
+            lc.set_array(devs)
+            lc.set_alpha(1.0 if kk == k else 0.35)
+        f = sc["frames"][k]
+        title.set_text(f"{name}: frame {f}, t = {(f + 1) * sc['dt']:.2f} s (colour: deviation from the reference)")
+        return []
+
+    anim = FuncAnimation(fig, draw, frames=len(sc["frames"]), blit=False)
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.86, wspace=0.05, hspace=0.3)
+    anim.save(path, writer=PillowWriter(fps=1.0 / (sc["stride"] * sc["dt"])))
+    plt.close(fig)
 
 
 # --- tables -----------------------------------------------------------------------------
@@ -934,10 +1154,15 @@ def write_html(report, path, charts, pareto_by_scenario):
              "td:first-child,td:nth-child(2),td:nth-child(3){text-align:left}th{background:#eee}"
              "img{max-width:100%}figure{margin:1em 0}figcaption{color:#555;font-size:13px}"
              "tr.front td{background:#eef7ee}table.overview td{text-align:center;font-size:12px;line-height:1.3}"
-             "table.overview th{text-align:left}",
+             "table.overview th{text-align:left}.hb-panels{display:flex;flex-wrap:wrap;gap:4px}"
+             ".hb-panel{margin:0;border:1px solid #ccc}.hb-panel figcaption{font-size:11px;padding:2px 4px;height:30px}"
+             ".hb-stretched figcaption{background:#fbe99a}.hb-deformed figcaption{background:#dcc3ee}"
+             ".hb-unstable figcaption{background:#f9b56b}.hb-diverged figcaption{background:#ef8a8a}"
+             ".hb-track{display:inline-flex;flex-direction:column;vertical-align:middle}.hb-slider{width:600px;margin:0}.hb-named{font-size:12px;color:#555}",
              "</style></head><body>", "<h1>hairbench report</h1>", f"<p>{e(context_line(report))}</p>"]
     parts += overview_html(report)
     parts += truth_html(report)
+    parts += player_html(report)
     parts.append(img_tag(charts["time_vs_error"]["files"][0], "Run time against error (log–log); the Pareto front "
                          "is ringed; runs asleep through a scenario sit on the time axis's floor"))
     parts.append("<h2>Details</h2>")
@@ -969,6 +1194,8 @@ def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("report")
     ap.add_argument("--out-dir", help="where to write (default: the report's folder)")
+    ap.add_argument("--animate", metavar="SCENARIO",
+                    help="write only STEM_SCENARIO.gif, the scenario's motion player as an animation")
     ap.add_argument("--svg", action="store_true",
                     help="also write every chart as SVG (default: HAIRBENCH_SVG=1 in the environment)")
     args = ap.parse_args(argv)
@@ -981,6 +1208,11 @@ def main(argv):
         os.makedirs(out_dir, exist_ok=True)
         stem = os.path.splitext(os.path.basename(args.report))[0]
         plt.rcParams.update({"font.size": 8, "svg.fonttype": "none"})
+        if args.animate:
+            gif = os.path.join(out_dir, f"{stem}_{args.animate}.gif")
+            write_animation(report, args.animate, gif)
+            print(f"charts: wrote {gif}")
+            return 0
 
         written = []
         charts = {

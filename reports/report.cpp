@@ -1,5 +1,8 @@
 #include "reports/report.h"
 
+#include "reports/animation.h"
+#include "reports/base64.h"
+
 #include "reports/metrics.h"
 
 #include "git_sha.h"
@@ -7,6 +10,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -21,9 +26,16 @@ namespace {
 // NaN and Inf are never bare tokens in the report: they become null (docs/report-schema.md).
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
+// Per-frame series are for plotting, at 6 significant digits: the summaries beside them
+// are computed from the full values. Printed in full, the series were half of a default
+// comparison's report.
 nlohmann::json series(const std::vector<double>& v) {
   nlohmann::json a = nlohmann::json::array();
-  for (double x : v) a.push_back(num(x));
+  char b[32];
+  for (double x : v) {
+    std::snprintf(b, sizeof b, "%.6g", x);
+    a.push_back(num(std::strtod(b, nullptr)));
+  }
   return a;
 }
 
@@ -95,7 +107,12 @@ nlohmann::json snapshot_json(const RunRecord::Snapshot& s, const RunRecord::Snap
   return out;
 }
 
-constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+nlohmann::json animation_json(const RunRecord::Animation& a) {
+  nlohmann::json out = {{"frames", a.frames}, {"ended", a.ended}};
+  if (a.same_as_reference) out["same_as_reference"] = true;
+  else out["data"] = a.data;
+  return out;
+}
 
 // Beyond this a position is a blown-up run, not hair: the strand is written as null.
 constexpr double kSnapshotMaxMetres = 1e6;
@@ -130,35 +147,18 @@ std::optional<std::string> encode_snapshot_strand(const std::vector<float>& xyz,
     for (; z >= 0x80; z >>= 7) bytes.push_back(static_cast<char>((z & 0x7f) | 0x80));
     bytes.push_back(static_cast<char>(z));
   }
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
-    std::uint32_t w = 0;
-    for (std::size_t k = 0; k < 3; ++k)
-      w = (w << 8) | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
-    for (std::size_t k = 0; k < 4; ++k) out.push_back(k <= n ? kBase64[(w >> (18 - 6 * k)) & 0x3f] : '=');
-  }
-  return out;
+  return base64_encode(bytes);
 }
 
 std::vector<double> decode_snapshot_strand(std::string_view code, const std::vector<double>* ref) {
   auto fail = [&](const char* why) {
     throw std::runtime_error("snapshot strand \"" + std::string(code.substr(0, 16)) + "\": " + why);
   };
-  if (code.size() % 4) fail("base64 length is not a multiple of 4");
   std::string bytes;
-  for (std::size_t i = 0; i < code.size(); i += 4) {
-    std::uint32_t w = 0;
-    std::size_t pad = 0;
-    for (std::size_t k = 0; k < 4; ++k) {
-      const char c = code[i + k];
-      const char* at = c == '=' ? nullptr : std::strchr(kBase64, c);
-      if (c == '=') ++pad;
-      else if (!at || !c || pad) fail("not base64");
-      w = (w << 6) | (at ? static_cast<std::uint32_t>(at - kBase64) : 0u);
-    }
-    if (pad > 2 || (pad && i + 4 != code.size())) fail("misplaced base64 padding");
-    for (std::size_t k = 0; k < 3 - pad; ++k) bytes.push_back(static_cast<char>((w >> (16 - 8 * k)) & 0xff));
+  try {
+    bytes = base64_decode(code);
+  } catch (const std::invalid_argument& e) {
+    fail(e.what());
   }
   std::vector<std::int64_t> q;
   for (std::size_t i = 0; i < bytes.size();) {
@@ -377,6 +377,7 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
     if (const metrics::Column& col = metrics::column(c); col.reported && !(col.follow_only && r.frame_values[c].empty()))
       out["series"][std::string(col.name)] = series(r.frame_values[c]);
   if (!r.device.empty()) out["device"] = r.device;
+  if (r.animation) out["animation"] = animation_json(*r.animation);
   if (!r.gpu_ms.empty()) out["series"]["gpu_ms"] = series(r.gpu_ms);
   if (!r.gpu_ms_lockstep.empty()) out["series"]["gpu_ms_lockstep"] = series(r.gpu_ms_lockstep);
   return out;
@@ -417,6 +418,31 @@ nlohmann::json scenario_json(const ScenarioRecord& sc) {
             {"reference", {{"model", sc.reference}, {"snapshots", std::move(ref)}}}}},
           {"reference_state_hash", metrics::hash_hex(sc.reference_state_hash)}};
   if (!sc.groom.is_null()) out["groom"] = sc.groom;
+  if (sc.animation) {
+    const ScenarioRecord::Animation& a = *sc.animation;
+    nlohmann::json frames = nlohmann::json::array(), heads = nlohmann::json::array(), named = nlohmann::json::array();
+    for (std::size_t k = 0; k < a.heads.size(); ++k) {
+      frames.push_back(static_cast<int>(k) * a.stride);
+      // 1e-6 m and 1e-6 of a rotation: far below the player's millimetre.
+      nlohmann::json h = nlohmann::json::array();
+      const Affine3f& m = a.heads[k];
+      for (int i = 0; i < 3; ++i) h.push_back(std::round(double(m.translation()[i]) * 1e6) / 1e6);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) h.push_back(std::round(double(m.linear()(i, j)) * 1e6) / 1e6);
+      heads.push_back(std::move(h));
+    }
+    for (const auto& n : a.named) named.push_back({{"strand", n.strand}, {"model", n.model}, {"why", n.why}});
+    nlohmann::json reference = animation_json(a.reference);
+    reference["model"] = sc.reference;
+    out["animation"] = {{"stride", a.stride},
+                        {"unit_metres", animation::kUnitMetres},
+                        {"frames", std::move(frames)},
+                        {"head", std::move(heads)},
+                        {"strands", a.strands},
+                        {"named", std::move(named)},
+                        {"vertices", a.vertices},
+                        {"reference", std::move(reference)}};
+  }
   return out;
 }
 
@@ -426,6 +452,7 @@ nlohmann::json make_report(const ReportContext& ctx, const std::vector<RunRecord
                       {"schema_version", 3},
                       {"context", context_json(ctx)},
                       {"snapshot_encoding", kSnapshotEncoding},
+                      {"animation_encoding", animation::kEncoding},
                       {"metric_definitions", metrics::definitions_json()}};
   j["runs"] = nlohmann::json::array();
   for (const RunRecord& r : runs) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.h"
+#include "reports/animation.h"
 #include "reports/frame_metrics.h"
 #include "reports/material.h"
 #include "reports/truth.h"
@@ -109,6 +110,16 @@ struct RunRecord {
     std::vector<std::vector<float>> strands;  // per snapshot strand: x0 y0 z0 x1 y1 z1 ...
   };
   std::vector<Snapshot> snapshots;
+  // The run's frames for report.html's player (reports/animation.h; ScenarioRecord's
+  // animation says which strands and frames): `frames` recorded, `data` encoded. The
+  // reference's own run has no data of its own (`same_as_reference`): it is the scenario's.
+  struct Animation {
+    int frames = 0;
+    std::string data;
+    bool same_as_reference = false;
+    bool ended = false;  // stopped by a blown-up coordinate, not by the run's end
+  };
+  std::optional<Animation> animation;
 };
 
 // What the runs of one scenario share: its script phases, and the frames and strands
@@ -137,6 +148,18 @@ struct ScenarioRecord {
   std::vector<SnapshotFrame> snapshot_frames;
   std::string reference;
   std::vector<RunRecord::Snapshot> reference_snapshots;
+  // The player's frames (reports/animation.h): every `stride`-th frame, the strands drawn
+  // (groom indices; `named` says which a verdict picked and why), each one's drawn
+  // vertices, the head pose at each recorded frame and the reference's frames.
+  struct Animation {
+    int stride = 1;
+    std::vector<std::uint32_t> strands;
+    std::vector<animation::Named> named;
+    std::vector<std::vector<std::uint32_t>> vertices;
+    std::vector<Affine3f> heads;
+    RunRecord::Animation reference;
+  };
+  std::optional<Animation> animation;
   // The reference's final positions (metrics::state_hash): every shard of a sweep runs
   // the reference itself, and hairbench merge checks that they all got the same bits.
   std::uint64_t reference_state_hash = 0;

@@ -17,7 +17,9 @@ std::string_view status_name(Status s) {
 }
 
 void StretchTracker::add(int frame, const metrics::LengthError& e) {
-  if (!(e.max <= kStretchLimit)) ++s_.frames_above;  // NaN counts: the edge is not within the limit
+  if (!(e.max <= kStretchLimit)) {  // NaN counts: the edge is not within the limit
+    if (!s_.frames_above++) s_.first_above = frame;
+  }
   if (e.max > s_.peak || (s_.peak_frame < 0 && std::isfinite(e.max))) {
     s_.peak = e.max;
     s_.peak_frame = frame;
@@ -222,6 +224,8 @@ nlohmann::json verdict_json(const Verdict& v) {
                         {"worst_strand", v.stretch.worst_strand},
                         {"worst_edge", v.stretch.worst_edge},
                         {"frames_above", v.stretch.frames_above},
+                        {"first_above",
+                         v.stretch.first_above >= 0 ? nlohmann::json(v.stretch.first_above) : nlohmann::json(nullptr)},
                         {"pinned_end", v.stretch.pinned_end}}},
                       {"settle",
                        {{"frames", v.settle.frames},

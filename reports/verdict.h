@@ -44,6 +44,7 @@ struct Stretch {
   int peak_frame = -1;
   std::uint32_t worst_strand = 0, worst_edge = 0;  // where the peak was
   int frames_above = 0;     // frames whose largest edge error exceeds kStretchLimit
+  int first_above = -1;     // the first of them (-1: none)
   // The worst edge joins a free vertex to one the groom pins past the root edge (a TressFX
   // strand tied at its tip, say): a model that cannot close the loop stretches it there.
   bool pinned_end = false;
