@@ -336,7 +336,7 @@ std::vector<DeviceRecord> gpu_devices(const CompareArgs& a) {
 // clocks are read again as it is written.
 int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<DeviceRecord> devices,
                  const std::vector<RunRecord>& runs, const std::vector<ScenarioRecord>& scenarios,
-                 const nlohmann::json& sweep, const Plan& plan) {
+                 const nlohmann::json& sweep, const Plan& plan, const nlohmann::json& time_s) {
   for (DeviceRecord& d : devices) {
     const GpuClock clock = read_gpu_clock(d.name);
     d.clock_end_mhz = clock.mhz;
@@ -347,6 +347,7 @@ int write_report(const CompareArgs& a, const ThreadPool& pool, std::vector<Devic
       make_report(ReportContext{pool.threads(), std::move(devices), plugins_json(a.plugins)}, runs, scenarios);
   if (!sweep.is_null()) report["sweep"] = sweep;
   if (a.shard.active()) report["shard"] = shard_json(plan, a.shard);
+  report["time_s"] = time_s;
   write_json(out, report);
   std::printf("wrote %s\n", out.string().c_str());
   return a.charts ? draw_charts(out) : 0;
@@ -425,23 +426,34 @@ void check_groom_args(const CompareArgs& a) {
   if (a.groom.empty() && a.fit_above) throw InputError("arguments", "--fit-above", "applies to --groom only");
 }
 
-// Where a comparison's time went: stepping the models is what it measures; the rest is
-// overhead.
+// Where a comparison's time went (report.json's time_s): stepping the models is what it
+// measures; the rest is overhead.
 struct TimeSplit {
   double models_s = 0.0, runs_s = 0.0, probes_s = 0.0, twins_s = 0.0, setup_s = 0.0, extra_s = 0.0;
+  double metrics_cpu_s = 0.0, animation_s = 0.0;
   void add(const RunRecord& r) {
     for (double ms : r.step_ms) models_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
     probes_s += r.probe_s;
     twins_s += r.twin_s;
     setup_s += r.setup_s;
     extra_s += r.settle_extra_s;
+    metrics_cpu_s += r.metrics_s;
+    animation_s += r.animation_s;
+  }
+  double other_s() const { return runs_s - models_s - probes_s - twins_s - setup_s - extra_s - animation_s; }
+  nlohmann::json json(const GroomTimes& groom) const {
+    return {{"load", groom.load_s},   {"fit", groom.fit_s},       {"runs", runs_s},
+            {"model_steps", models_s}, {"probes", probes_s},     {"twins", twins_s},
+            {"setup", setup_s},        {"settle_extra", extra_s}, {"animation", animation_s},
+            {"metrics_cpu", metrics_cpu_s}, {"other", other_s()},
+            {"overhead_share", models_s > 0 ? nlohmann::json((runs_s - models_s) / models_s) : nlohmann::json()}};
   }
   void print(const GroomTimes& groom) const {
     std::printf("time: load %.3f s (read, repairs, follow hairs), fit %.3f s (unit, head sphere, collider), "
-                "model steps %.3f s, the models' probes %.3f s, rest twins %.3f s, setup %.3f s and steps past the "
-                "end %.3f s, metrics and the rest %.3f s\n",
-                groom.load_s, groom.fit_s, models_s, probes_s, twins_s, setup_s, extra_s,
-                runs_s - models_s - probes_s - twins_s - setup_s - extra_s);
+                "model steps %.3f s, the models' probes %.3f s, rest twins %.3f s, setup %.3f s, steps past the "
+                "end %.3f s, the player's frames %.3f s, metrics (%.3f s of CPU) and the rest %.3f s\n",
+                groom.load_s, groom.fit_s, models_s, probes_s, twins_s, setup_s, extra_s, animation_s,
+                metrics_cpu_s, other_s());
   }
 };
 
@@ -512,10 +524,10 @@ int run_batches(CompareArgs& a, bool sweep) {
       for (RunRecord& r : got) runs.push_back(std::move(r));
     }
   }
-  if (!a.groom.empty()) time.print(groom_times);
+  time.print(groom_times);
   nlohmann::json sweep_json;
   if (a.knob) sweep_json = {{"knob", knob_name}, {"values", values}, {"models", a.run.models}};
-  return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan);
+  return write_report(a, pool, std::move(devices), runs, records, sweep_json, plan, time.json(groom_times));
 }
 
 struct StressArgs {

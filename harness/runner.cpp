@@ -62,6 +62,19 @@ std::vector<ParamOverride> concat(std::vector<ParamOverride> a, const std::vecto
   return a;
 }
 
+// Adds the wall time of its scope to a counter (RunRecord::metrics_s, animation_s).
+class LaneTimer {
+ public:
+  explicit LaneTimer(double& into) : into_(into), start_(std::chrono::steady_clock::now()) {}
+  ~LaneTimer() { into_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  LaneTimer(const LaneTimer&) = delete;
+  LaneTimer& operator=(const LaneTimer&) = delete;
+
+ private:
+  double& into_;
+  const std::chrono::steady_clock::time_point start_;
+};
+
 // Copies the snapshot strands' positions (xyz) out of a model's state.
 void take_snapshot(const Groom& g, std::span<const std::uint32_t> strands, std::span<const Vec4f> p,
                    RunRecord::Snapshot& out, int frame) {
@@ -432,6 +445,7 @@ void LockstepRun::stop_diverged(const FrameInput& in, int f, bool driven) {
     for (std::size_t i = b; i < e; ++i) {
       Lane& l = lanes_[i];
       if (!l.running) continue;
+      const LaneTimer timer(l.record.metrics_s);
       if (l.device) {
         DeviceMetricsFrame lane_frame = frame;
         if (!l.device_reference) lane_frame.reference = reference;
@@ -488,11 +502,13 @@ void LockstepRun::measure(const FrameInput& in) {
       host_lanes = true;
     }
   if (ref_ok && host_lanes && p[0].empty()) p[0] = lanes_[0].model->positions();
+  std::vector<double> spent(lanes_.size() * tasks, 0.0);
   pool_.parallel_for(lanes_.size() * tasks, [&](std::size_t b, std::size_t e) {
     for (std::size_t task = b; task < e; ++task) {
       const std::size_t i = task / tasks, m = task % tasks;
       const Lane& l = lanes_[i];
       if (!l.running) continue;
+      const LaneTimer timer(spent[task]);
       if (m == table.size()) {
         if (l.nodes)
           stretch[i] = metrics::length_error(*l.nodes, l.model->simulated_positions());
@@ -514,6 +530,7 @@ void LockstepRun::measure(const FrameInput& in) {
       (on_device ? fm.device : fm.host)(view, std::span(values[i]).subspan(metrics::first_column(m), fm.columns.size()));
     }
   });
+  for (std::size_t task = 0; task < spent.size(); ++task) lanes_[task / tasks].record.metrics_s += spent[task];
   // Where no other groom holds the simulated edges, the stretched verdict reads the
   // whole groom's length error, worst edge included (its last columns).
   static const std::size_t length = metrics::column_index("length_error_rms");
@@ -599,7 +616,10 @@ void LockstepRun::snapshot(const FrameInput& in, int f, int frames) {
 void LockstepRun::record_animation(const FrameInput& in) {
   anim_heads_.push_back(in.head);
   for (Lane& l : lanes_)
-    if (l.running) l.frames.add(l.model->positions(), in.head);
+    if (l.running) {
+      const LaneTimer timer(l.record.animation_s);
+      l.frames.add(l.model->positions(), in.head);
+    }
 }
 
 // Once the verdicts are in: the strands drawn are the spread ones and each strand a
@@ -618,6 +638,7 @@ void LockstepRun::encode_animation() {
   for (Lane& l : lanes_) l.record.animation.emplace();
   pool_.parallel_for(lanes_.size(), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
+      const LaneTimer timer(lanes_[i].record.animation_s);
       const animation::Recorder& f = lanes_[i].frames;
       *lanes_[i].record.animation = {f.frames(), f.encode(strands), false, f.ended()};
     }

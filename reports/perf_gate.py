@@ -268,6 +268,40 @@ def judge_accuracy(base_path, base_doc, cand_path, cand_doc):
     return rows
 
 
+def time_split(doc):
+    """Per model, summed over its runs: the timed steps, its own work outside them (probe,
+    rest twin, setup, steps past the end, the player's frames; wall s) and its metrics'
+    CPU s, from runs[].timing (docs/report-schema.md). A report from before timing.steps_s
+    sums series.step_ms; one without overhead_s counts none."""
+    out = {}
+    for r in doc.get("runs", []):
+        t = r.get("timing", {})
+        steps = t.get("steps_s")
+        if not isinstance(steps, (int, float)):
+            steps = sum(v for v in r.get("series", {}).get("step_ms", []) if isinstance(v, (int, float))) / 1e3
+        over = t.get("overhead_s", {})
+        own = sum(v for k, v in over.items() if k != "metrics_cpu" and isinstance(v, (int, float)))
+        m = out.setdefault(r.get("model"), [0.0, 0.0, 0.0])
+        m[0] += steps
+        m[1] += own
+        m[2] += over.get("metrics_cpu", 0.0) if isinstance(over.get("metrics_cpu"), (int, float)) else 0.0
+    return out
+
+
+def time_split_table(base_doc, cand_doc):
+    """Baseline and candidate side by side, per model: where each run's time went. Not a
+    gate: the speed gate is the benchmarks'; this says where a change moved the time."""
+    base, cand = time_split(base_doc), time_split(cand_doc)
+    lines = ["| model | steps s (base / cand) | own overhead s | metrics CPU s | overhead / steps |",
+             "|---|---:|---:|---:|---:|"]
+    for model in sorted(set(base) | set(cand), key=str):
+        b, c = base.get(model, [math.nan] * 3), cand.get(model, [math.nan] * 3)
+        share = ["-" if not x[0] > 0 else f"{(x[1] + x[2]) / x[0]:.2f}" for x in (b, c)]
+        lines.append(f"| {model} | {b[0]:.3g} / {c[0]:.3g} | {b[1]:.3g} / {c[1]:.3g} | {b[2]:.3g} / {c[2]:.3g} "
+                     f"| {share[0]} / {share[1]} |")
+    return "\n".join(lines)
+
+
 # --- Output ------------------------------------------------------------------------
 
 
@@ -341,6 +375,8 @@ def main(argv=None):
                             for k, (r, a) in accuracy_tolerances(args.candidate_report, cand_doc).items())
             sections.append(f"### Accuracy (tolerances: {tol}; a run no longer ok "
                             "fails)\n\n" + accuracy_table(rows))
+            sections.append("### Where the time went (per model, summed over scenarios; not gated)\n\n"
+                            + time_split_table(load_json(args.baseline_report), cand_doc))
         if not sections:
             raise GateError("nothing to compare: give benchmark, count or report files")
     except GateError as e:

@@ -301,8 +301,9 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
   for (const auto& [name, total] : r.stage_ms_total) stage[name] = num(total * per);
 
   const double med = median(worked);
-  double asleep_ms = 0.0;
+  double asleep_ms = 0.0, steps_s = 0.0;
   for (double ms : asleep) asleep_ms += ms;
+  for (double ms : r.step_ms) steps_s += std::isfinite(ms) ? ms / 1e3 : 0.0;
   nlohmann::json timing = {
       {"step_ms",
        {{"frames", "worked"},
@@ -318,7 +319,14 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
       {"stage_ms", stage},
       {"stage_skipped_steps", r.stage_skipped_steps},
       {"ns_per_vertex", num(med * 1e6 / static_cast<double>(r.vertices))},
-      {"overhead_s", {{"probe", r.probe_s}, {"twin", r.twin_s}, {"setup", r.setup_s}, {"settle_extra", r.settle_extra_s}}}};
+      {"steps_s", steps_s},
+      {"overhead_s",
+       {{"probe", r.probe_s},
+        {"twin", r.twin_s},
+        {"setup", r.setup_s},
+        {"settle_extra", r.settle_extra_s},
+        {"metrics_cpu", r.metrics_s},
+        {"animation", r.animation_s}}}};
 
   if (r.stream_ms > 0.0) {
     timing["state_bytes"] = r.state_bytes;

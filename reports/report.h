@@ -91,6 +91,10 @@ struct RunRecord {
   // at rest, making and resetting it, and the frames stepped past the scenario's end for
   // the settle check (timing.overhead_s).
   double probe_s = 0.0, twin_s = 0.0, setup_s = 0.0, settle_extra_s = 0.0;
+  // The harness's per-frame work on this run, also timing.overhead_s: its divergence
+  // checks and metric tasks, summed over the pool's tasks (CPU seconds: on two threads the
+  // wall time is about half), and recording and encoding its player frames (wall).
+  double metrics_s = 0.0, animation_s = 0.0;
 
   // Parameters given to the reference on top of the scenario's (--reference converged);
   // empty when the reference runs at the scenario's parameters.

@@ -153,6 +153,20 @@ class AccuracyDecisions(unittest.TestCase):
             perf_gate.judge_accuracy("b", {"runs": []}, "c", report([]))
 
 
+class TimeSplit(unittest.TestCase):
+    def test_sums_each_models_runs_and_reads_reports_before_steps_s(self):
+        a, b, old = run("m"), run("m"), run("n")
+        a["timing"] = {"steps_s": 2.0, "overhead_s": {"probe": 0.5, "twin": 0.25, "metrics_cpu": 1.0}}
+        b["timing"] = {"steps_s": 1.0, "overhead_s": {"animation": 0.25, "metrics_cpu": 0.5}}
+        old["series"] = {"step_ms": [1000.0, 500.0, None]}
+        split = perf_gate.time_split(report([a, b, old]))
+        self.assertEqual(split["m"], [3.0, 1.0, 1.5])
+        self.assertEqual(split["n"], [1.5, 0.0, 0.0])
+        table = perf_gate.time_split_table(report([old]), report([a, b, old]))
+        self.assertIn("| m | nan / 3 | nan / 1 | nan / 1.5 | - / 0.83 |", table)
+        self.assertIn("| n | 1.5 / 1.5 |", table)
+
+
 class CommandLine(unittest.TestCase):
     def write(self, d, name, doc):
         path = os.path.join(d, name)
