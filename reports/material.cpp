@@ -31,7 +31,7 @@ std::vector<PronyMode> prony_modes(std::span<const double> x, double dt, std::si
     for (int k = 0; k < order; ++k) lp(i - order, k) = w[i - 1 - k];
     rhs[i - order] = w[i];
   }
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(lp, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(lp, Eigen::ComputeThinU | Eigen::ComputeThinV);
   svd.setThreshold(1e-9);
   const Eigen::VectorXd a = svd.solve(rhs);
   // The modes: the roots z_k of z^order - sum a_k z^(order-k), the companion matrix's
