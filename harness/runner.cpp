@@ -632,15 +632,14 @@ void LockstepRun::encode_animation() {
   for (const Lane& l : lanes_)
     for (animation::Named& n : animation::named_strands(l.record.verdict, l.record.model, anim_candidates_))
       a.named.push_back(std::move(n));
-  const std::vector<std::uint32_t> strands = animation::drawn_strands(anim_candidates_, a.named);
-  a.strands = strands;
-  for (std::uint32_t s : strands) a.vertices.push_back(animation::picked_vertices(sc_.groom.strand_size(s)));
+  a.strands = animation::drawn_strands(anim_candidates_, a.named);
+  for (std::uint32_t s : a.strands) a.vertices.push_back(animation::picked_vertices(sc_.groom.strand_size(s)));
   for (Lane& l : lanes_) l.record.animation.emplace();
   pool_.parallel_for(lanes_.size(), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const LaneTimer timer(lanes_[i].record.animation_s);
       const animation::Recorder& f = lanes_[i].frames;
-      *lanes_[i].record.animation = {f.frames(), f.encode(strands), false, f.ended()};
+      *lanes_[i].record.animation = {f.frames(), f.encode(a.strands), false, f.ended()};
     }
   });
   a.reference = *lanes_[0].record.animation;

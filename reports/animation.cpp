@@ -1,6 +1,6 @@
 #include "reports/animation.h"
 
-#include "reports/base64.h"
+#include "reports/packing.h"
 
 #include <zlib.h>
 
@@ -123,12 +123,7 @@ std::string encode(std::span<const std::int32_t> q, std::span<const std::uint32_
   for (std::size_t f = 0; f * n < q.size(); ++f) {
     const std::span<const std::int32_t> cur = q.subspan(f * n, n);
     const std::int32_t* prev = f ? q.data() + (f - 1) * n : nullptr;
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::int64_t r = cur[i] - predict(cur, prev, i, root[i]);
-      std::uint64_t z = (static_cast<std::uint64_t>(r) << 1) ^ static_cast<std::uint64_t>(r >> 63);
-      for (; z >= 0x80; z >>= 7) bytes.push_back(static_cast<char>((z & 0x7f) | 0x80));
-      bytes.push_back(static_cast<char>(z));
-    }
+    for (std::size_t i = 0; i < n; ++i) append_zigzag(bytes, cur[i] - predict(cur, prev, i, root[i]));
   }
   uLongf packed_size = compressBound(bytes.size());
   std::string packed(packed_size, '\0');
@@ -164,23 +159,20 @@ std::vector<std::int32_t> decode(std::string_view code, std::span<const std::uin
   const std::vector<bool> root = roots(sizes);
   const std::size_t n = root.size();
   if (n == 0) fail(code, "no strands to decode into");
-  std::vector<std::int32_t> q;
-  for (std::size_t i = 0; i < bytes.size();) {
-    std::uint64_t z = 0;
-    for (int shift = 0;; shift += 7) {
-      if (i >= bytes.size() || shift > 63) fail(code, "truncated varint");
-      const auto b = static_cast<unsigned char>(bytes[i++]);
-      z |= std::uint64_t(b & 0x7f) << shift;
-      if (!(b & 0x80)) break;
-    }
-    const std::size_t at = q.size(), f = at / n;
-    q.push_back(0);  // before taking pointers into q
-    const std::int32_t* prev = f ? q.data() + (f - 1) * n : nullptr;
-    const std::span<const std::int32_t> cur(q.data() + f * n, at - f * n + 1);
-    const auto r = static_cast<std::int64_t>(z >> 1) ^ -static_cast<std::int64_t>(z & 1);
-    q.back() = static_cast<std::int32_t>(r + predict(cur, prev, at - f * n, root[at - f * n]));
+  std::vector<std::int64_t> r;
+  try {
+    r = read_zigzag(bytes);
+  } catch (const std::invalid_argument& e) {
+    fail(code, e.what());
   }
-  if (q.size() % n) fail(code, "not a whole number of frames");
+  if (r.size() % n) fail(code, "not a whole number of frames");
+  std::vector<std::int32_t> q(r.size());
+  for (std::size_t f = 0; f * n < q.size(); ++f) {
+    const std::span<const std::int32_t> cur(q.data() + f * n, n);
+    const std::int32_t* prev = f ? q.data() + (f - 1) * n : nullptr;
+    for (std::size_t i = 0; i < n; ++i)
+      q[f * n + i] = static_cast<std::int32_t>(r[f * n + i] + predict(cur, prev, i, root[i]));
+  }
   return q;
 }
 

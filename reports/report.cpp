@@ -1,7 +1,7 @@
 #include "reports/report.h"
 
 #include "reports/animation.h"
-#include "reports/base64.h"
+#include "reports/packing.h"
 
 #include "reports/metrics.h"
 
@@ -142,10 +142,7 @@ std::optional<std::string> encode_snapshot_strand(const std::vector<float>& xyz,
   std::string bytes;
   for (std::size_t i = 0; i < q.size(); ++i) {
     const std::int64_t pred = i >= 6 ? 2 * q[i - 3] - q[i - 6] : i >= 3 ? q[i - 3] : 0;
-    const std::int64_t r = q[i] - pred;
-    std::uint64_t z = (static_cast<std::uint64_t>(r) << 1) ^ static_cast<std::uint64_t>(r >> 63);
-    for (; z >= 0x80; z >>= 7) bytes.push_back(static_cast<char>((z & 0x7f) | 0x80));
-    bytes.push_back(static_cast<char>(z));
+    append_zigzag(bytes, q[i] - pred);
   }
   return base64_encode(bytes);
 }
@@ -154,25 +151,13 @@ std::vector<double> decode_snapshot_strand(std::string_view code, const std::vec
   auto fail = [&](const char* why) {
     throw std::runtime_error("snapshot strand \"" + std::string(code.substr(0, 16)) + "\": " + why);
   };
-  std::string bytes;
+  std::vector<std::int64_t> q;
   try {
-    bytes = base64_decode(code);
+    q = read_zigzag(base64_decode(code));
   } catch (const std::invalid_argument& e) {
     fail(e.what());
   }
-  std::vector<std::int64_t> q;
-  for (std::size_t i = 0; i < bytes.size();) {
-    std::uint64_t z = 0;
-    for (int shift = 0;; shift += 7) {
-      if (i >= bytes.size() || shift > 63) fail("truncated varint");
-      const auto b = static_cast<unsigned char>(bytes[i++]);
-      z |= std::uint64_t(b & 0x7f) << shift;
-      if (!(b & 0x80)) break;
-    }
-    const auto r = static_cast<std::int64_t>(z >> 1) ^ -static_cast<std::int64_t>(z & 1);
-    const std::size_t n = q.size();
-    q.push_back(r + (n >= 6 ? 2 * q[n - 3] - q[n - 6] : n >= 3 ? q[n - 3] : 0));
-  }
+  for (std::size_t n = 0; n < q.size(); ++n) q[n] += n >= 6 ? 2 * q[n - 3] - q[n - 6] : n >= 3 ? q[n - 3] : 0;
   if (q.size() % 3) fail("coordinate count is not a multiple of 3");
   if (ref && ref->size() != q.size()) fail("not as long as the reference's strand");
   std::vector<double> xyz(q.size());

@@ -1,4 +1,4 @@
-#include "reports/base64.h"
+#include "reports/packing.h"
 
 #include <cstdint>
 #include <cstring>
@@ -8,6 +8,27 @@ namespace hairbench {
 
 namespace {
 constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+}
+
+void append_zigzag(std::string& bytes, std::int64_t r) {
+  std::uint64_t z = (static_cast<std::uint64_t>(r) << 1) ^ static_cast<std::uint64_t>(r >> 63);
+  for (; z >= 0x80; z >>= 7) bytes.push_back(static_cast<char>((z & 0x7f) | 0x80));
+  bytes.push_back(static_cast<char>(z));
+}
+
+std::vector<std::int64_t> read_zigzag(std::string_view bytes) {
+  std::vector<std::int64_t> out;
+  for (std::size_t i = 0; i < bytes.size();) {
+    std::uint64_t z = 0;
+    for (int shift = 0;; shift += 7) {
+      if (i >= bytes.size() || shift > 63) throw std::invalid_argument("truncated varint");
+      const auto b = static_cast<unsigned char>(bytes[i++]);
+      z |= std::uint64_t(b & 0x7f) << shift;
+      if (!(b & 0x80)) break;
+    }
+    out.push_back(static_cast<std::int64_t>(z >> 1) ^ -static_cast<std::int64_t>(z & 1));
+  }
+  return out;
 }
 
 std::string base64_encode(std::string_view bytes) {
