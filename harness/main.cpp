@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "git_sha.h"
+#include "harness/at_rest_cache.h"
 #include "harness/charts.h"
 #include "harness/gpu_clock.h"
 #include "harness/merge.h"
@@ -478,6 +479,7 @@ int run_batches(CompareArgs& a, bool sweep) {
 
   TimeSplit time;
   ThreadPool pool(a.threads);
+  AtRestCache at_rest;
   Progress progress(total, true);
   std::vector<RunRecord> runs;
   std::vector<ScenarioRecord> records;
@@ -486,6 +488,7 @@ int run_batches(CompareArgs& a, bool sweep) {
     bool recorded = false;
     for (std::size_t k = 0; k < std::max<std::size_t>(values.size(), 1); ++k) {
       RunOptions opt = a.run;
+      opt.at_rest = &at_rest;
       opt.models.clear();
       for (const std::string& m : a.run.models)
         if (plan.items[item++].shard == mine) opt.models.push_back(m);

@@ -6,6 +6,7 @@
 #include "harness/gpu_clock.h"
 #include "harness/calibrate.h"
 #include "harness/probe.h"
+#include "harness/at_rest_cache.h"
 #include "harness/twin.h"
 #include "harness/roofline.h"
 #include "harness/shard.h"
@@ -256,7 +257,11 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   AtRest at_rest;
-  if (opt_.probe) at_rest = probe_at_rest(*info, sc_, params, pool_, opt_.device, {true, opt_.material_card});
+  std::string probe_from, twin_from;
+  const AtRestParts parts{true, opt_.material_card};
+  if (opt_.probe)
+    at_rest = opt_.at_rest ? opt_.at_rest->probe(*info, sc_, params, pool_, opt_.device, parts, probe_from)
+                           : probe_at_rest(*info, sc_, params, pool_, opt_.device, parts);
   if (!opt_.probe || !opt_.material_card) at_rest.card = {};
   if (!opt_.probe) at_rest.card.skipped_why = "not measured (the probe at rest is off)";
   else if (!opt_.material_card) at_rest.card.skipped_why = "not measured (RunOptions::material_card off)";
@@ -268,7 +273,11 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   // sleeping moves a state by less than 1e-4 L (docs/verdicts.md), a thousandth of the
   // deformed limit. A model whose rest state is unstable never sleeps.
   RestTwin twin;
-  if (opt_.twin && !sc_.truth) twin = rest_twin(*info, sc_, params, pool_, opt_.device, !(probe.run && probe.grows), frames_);
+  if (opt_.twin && !sc_.truth) {
+    const bool sleeps = !(probe.run && probe.grows);
+    twin = opt_.at_rest ? opt_.at_rest->twin(*info, sc_, params, pool_, opt_.device, sleeps, frames_, twin_from)
+                        : rest_twin(*info, sc_, params, pool_, opt_.device, sleeps, frames_);
+  }
   const auto twinned = Clock::now();
   Lane lane{info, params, make_model(*info, sc_, params, pool_, opt_.device, skip), {}, reported, true, {},
             metrics::EnergyGrowthCheck(rest_.mean_strand_length, sc_.gravity.norm()), {}, {}, probe, std::move(twin.positions), twin.frames};
@@ -277,6 +286,8 @@ void LockstepRun::add_lane(const ModelInfo* info, const ParamSet& params, bool r
   r.probe_s = std::chrono::duration<double>(probed - start).count();
   r.twin_s = std::chrono::duration<double>(twinned - probed).count();
   r.setup_s = std::chrono::duration<double>(Clock::now() - twinned).count();
+  r.probe_from = std::move(probe_from);
+  r.twin_from = std::move(twin_from);
   r.scenario = sc_.name;
   r.model = std::string(info->name);
   if (!info->origin.empty()) r.origin = std::string(info->origin);

@@ -18,6 +18,7 @@
 namespace hairbench {
 
 class ThreadPool;
+class AtRestCache;
 
 struct RunOptions {
   std::vector<std::string> models;  // to report, in order
@@ -46,6 +47,10 @@ struct RunOptions {
   // test or benchmark needs bare steps, or a caller reads no verdict but the
   // self-excited classes.
   bool twin = true;
+  // Where set, the probes and twins come from it (harness/at_rest_cache.h): scenarios
+  // that ask for the same copies at rest step them once. The cache must outlive the run
+  // and not the scenarios.
+  AtRestCache* at_rest = nullptr;
   // Each lane's material card (reports/material.h: the probe's third, harder-kicked copy
   // for the mode; sag and stretch cost nothing extra). Off where no report shows it
   // (stress cells), and then `--calibrate` has no target.

@@ -21,7 +21,8 @@ RestTwin rest_twin(const ModelInfo& info, const Scenario& sc, const ParamSet& pa
   StageTimes times;
   out.positions = sc.groom.positions;
   const double still = kTwinRestSpeed * kTwinRestSpeed * sc.dt * sc.dt * static_cast<double>(out.positions.size());
-  for (int f = 0, at_rest = 0; f < frames && at_rest < kTwinRestFrames; ++f) {
+  int at_rest = 0;
+  for (int f = 0; f < frames && at_rest < kTwinRestFrames; ++f) {
     in.frame = f;
     in.t = (f + 1) * sc.dt;
     model->step(in, times);
@@ -35,6 +36,7 @@ RestTwin rest_twin(const ModelInfo& info, const Scenario& sc, const ParamSet& pa
     at_rest = moved < still ? at_rest + 1 : 0;
     out.frames = f + 1;
   }
+  out.at_rest = at_rest >= kTwinRestFrames;
   return out;
 }
 

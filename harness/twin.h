@@ -25,6 +25,7 @@ struct RestTwin {
   Affine3f head = Affine3f::Identity();  // the final pose (head rest -> world)
   std::vector<Vec4f> positions;          // the twin's state at the end, in the head's frame
   int frames = 0;                        // frames it stepped
+  bool at_rest = false;                  // it stopped at rest (kTwinRestSpeed) before running out of frames
 };
 
 // Once every vertex of the twin has moved slower than this, RMS, for kRestFrames frames

@@ -311,7 +311,10 @@ nlohmann::json run_json(const RunRecord& r, const ScenarioRecord* sc) {
         {"setup", r.setup_s},
         {"settle_extra", r.settle_extra_s},
         {"metrics_cpu", r.metrics_s},
-        {"animation", r.animation_s}}}};
+        {"animation", r.animation_s}}},
+      {"shared_from",
+       {{"probe", r.probe_from.empty() ? nlohmann::json() : nlohmann::json(r.probe_from)},
+        {"twin", r.twin_from.empty() ? nlohmann::json() : nlohmann::json(r.twin_from)}}}};
 
   if (r.stream_ms > 0.0) {
     timing["state_bytes"] = r.state_bytes;

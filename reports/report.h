@@ -91,6 +91,9 @@ struct RunRecord {
   // at rest, making and resetting it, and the frames stepped past the scenario's end for
   // the settle check (timing.overhead_s).
   double probe_s = 0.0, twin_s = 0.0, setup_s = 0.0, settle_extra_s = 0.0;
+  // The scenario whose identical probe or twin this run was handed (harness/at_rest_cache.h;
+  // its time is counted there), or empty: computed for this run.
+  std::string probe_from, twin_from;
   // The harness's per-frame work on this run, also timing.overhead_s: its divergence
   // checks and metric tasks, summed over the pool's tasks (CPU seconds: on two threads the
   // wall time is about half), and recording and encoding its player frames (wall).

@@ -12,6 +12,7 @@
 // And for every built-in scenario, skipping (inert stages, sleep) changes no verdict, and
 // the reference every deviation is measured against is itself ok.
 #include "core/parallel.h"
+#include "harness/at_rest_cache.h"
 #include "harness/probe.h"
 #include "harness/runner.h"
 #include "reports/verdict.h"
@@ -169,10 +170,13 @@ TEST(Gauntlet, VerdictsFollowThePhysicsNotTheNumbers) {
 // do not interact but through plante_wisp's wisps), but for the TressFX ponytail's shake,
 // which runs whole with its follow hairs rebuilt from the guides (and skipped with them);
 // the other grooms with follow hairs run their guides alone, the follow layer being the
-// shake's.
+// shake's. The probe and the twin are the run's yardsticks, the same bits with skipping
+// or without (the twin sleeps in both, harness/twin.h): the two runs, and the scenarios
+// that share a groom, share them (harness/at_rest_cache.h).
 TEST(Sleep, SkippingNeverChangesAVerdictOrAMetric) {
   constexpr double kSleepTolerance = 1e-4;
   ThreadPool pool(2);
+  AtRestCache at_rest;
   for (const auto& file : builtin_scenarios()) {
     const std::string name = file.stem().string();
     Scenario sc = name == "tressfx_ponytail_shake" ? load_scenario(file) : simulated_guides(name);
@@ -183,6 +187,7 @@ TEST(Sleep, SkippingNeverChangesAVerdictOrAMetric) {
       RunOptions opt;
       opt.models = kCpuModels;
       opt.skip_inert = skip == 1;
+      opt.at_rest = &at_rest;
       runs[skip] = run_scenario(sc, opt, pool);
     }
     for (std::size_t i = 0; i < runs[0].size(); ++i) {

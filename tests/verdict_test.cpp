@@ -5,6 +5,7 @@
 // their node alone.
 #include "core/groom_fit.h"
 #include "core/parallel.h"
+#include "harness/at_rest_cache.h"
 #include "harness/probe.h"
 #include "harness/runner.h"
 #include "models/registry.h"
@@ -434,3 +435,58 @@ TEST(Verdict, TheForestHoldsStrandsTiedAtBothEndsStaticAndCountsThem) {
 }
 
 }  // namespace
+
+// A comparison's scenarios share their copies at rest (harness/at_rest_cache.h): nod asks
+// idle's questions (same groom, same pose at the end), tilt_upside_down only the probe's
+// (its head ends upside down), and a scenario with another gravity neither. What a run is
+// handed is the bits it would have stepped itself: its verdict and metrics are the same as
+// without the cache, in any order.
+TEST(AtRestCache, SharedCopiesAreTheBitsEachScenarioWouldStepItself) {
+  const std::vector<std::string> models{"han_m1", "halen_spring", "plante_wisp"};
+  Scenario idle = test::builtin("idle", 16), nod = test::builtin("nod", 16), tilt = test::builtin("tilt_upside_down", 16);
+  Scenario moon = test::builtin("nod", 16);
+  moon.name = "nod_on_the_moon";
+  moon.gravity *= 0.165f;
+  ThreadPool pool(2);
+  auto run = [&](const Scenario& sc, AtRestCache* cache) {
+    RunOptions opt;
+    opt.models = models;
+    opt.at_rest = cache;
+    return run_scenario(sc, opt, pool);
+  };
+  auto same = [](const std::vector<RunRecord>& a, const std::vector<RunRecord>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      SCOPED_TRACE(a[i].model);
+      const nlohmann::json ja = run_json(a[i]), jb = run_json(b[i]);
+      EXPECT_EQ(ja["verdict"].dump(), jb["verdict"].dump());
+      EXPECT_EQ(ja["metrics"].dump(), jb["metrics"].dump());
+    }
+  };
+  AtRestCache cache;
+  const std::vector<RunRecord> idle_shared = run(idle, &cache), nod_shared = run(nod, &cache),
+                               tilt_shared = run(tilt, &cache), moon_shared = run(moon, &cache);
+  same(idle_shared, run(idle, nullptr));
+  same(nod_shared, run(nod, nullptr));
+  same(tilt_shared, run(tilt, nullptr));
+  same(moon_shared, run(moon, nullptr));
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    SCOPED_TRACE(models[i]);
+    EXPECT_EQ(idle_shared[i].probe_from, "");
+    EXPECT_EQ(idle_shared[i].twin_from, "");
+    EXPECT_EQ(nod_shared[i].probe_from, "idle");
+    EXPECT_EQ(tilt_shared[i].probe_from, "idle");
+    EXPECT_EQ(tilt_shared[i].twin_from, "");
+    EXPECT_EQ(moon_shared[i].probe_from, "");
+    EXPECT_EQ(moon_shared[i].twin_from, "");
+    // idle runs 180 frames, nod 240: nod gets idle's twin only where it stopped at rest.
+    if (idle_shared[i].verdict.back.twin_frames < 180) EXPECT_EQ(nod_shared[i].twin_from, "idle");
+    else EXPECT_EQ(nod_shared[i].twin_from, "");
+  }
+  // And the other way round: nod first, then idle, which asks for fewer frames.
+  AtRestCache reversed;
+  const std::vector<RunRecord> nod_first = run(nod, &reversed), idle_second = run(idle, &reversed);
+  same(nod_first, nod_shared);
+  same(idle_second, idle_shared);
+  for (std::size_t i = 0; i < models.size(); ++i) EXPECT_EQ(idle_second[i].probe_from, "nod") << models[i];
+}
