@@ -1,5 +1,7 @@
 #include "reports/metrics.h"
 
+#include "reports/chunked.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -11,23 +13,6 @@ namespace hairbench::metrics {
 
 namespace {
 Eigen::Vector3d xyz(const Vec4f& v) { return v.head<3>().cast<double>(); }
-
-// The per-frame metrics cost about as much as a fast model's step in `compare`, which
-// computes them per model and frame. Their hot loops are built twice, for
-// x86-64-v4 (AVX-512) and the baseline, and chosen at load time; the IEEE operations
-// give the same bits in either (no FMA contraction, -ffp-contract=off).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define METRIC_CLONES __attribute__((target_clones("arch=x86-64-v4", "default")))
-#else
-#define METRIC_CLONES
-#endif
-// Their helpers are inlined into each build (a call would run the baseline build).
-#define METRIC_INLINE [[gnu::always_inline]] inline
-
-// A sum's terms are computed kChunk at a time into a buffer, by a loop that vectorises,
-// and added in order after it: the same additions in the same order as in one loop, so
-// the same bits, without each term's arithmetic waiting on the running sum.
-constexpr std::size_t kChunk = 256;
 
 // |a - b|^2 of two points in double: Eigen's (xyz(a) - xyz(b)).squaredNorm(), term by
 // term in its order, written out so that loops over points vectorise.
@@ -56,16 +41,6 @@ void group_for_lanes(const Groom& g, std::vector<std::uint32_t>& grouped, std::v
     i = j;
   }
   std::sort(alone.begin(), alone.end());
-}
-
-template <class Term, class Add>
-METRIC_INLINE void chunked(std::size_t begin, std::size_t end, Term term, Add add) {
-  decltype(term(begin)) buf[kChunk];
-  for (std::size_t c = begin; c < end; c += kChunk) {
-    const std::size_t m = std::min(kChunk, end - c);
-    for (std::size_t k = 0; k < m; ++k) buf[k] = term(c + k);
-    for (std::size_t k = 0; k < m; ++k) add(buf[k]);
-  }
 }
 
 // chunked over the edges (i - 1, i) of every strand, i in [1, end), as one run over the
@@ -470,14 +445,23 @@ METRIC_CLONES std::string blowup_reason(const RestInfo& rest, std::span<const Ve
 
 double blowup_distance(const RestInfo& rest) { return rest.head_extent + 10.0 * rest.mean_strand_length; }
 
-double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt, const Vec3f& gravity) {
+// Each vertex's 0.5 |v|^2 - g.p as Eigen's Vector3d expressions compute it, written out
+// in their order ((x^2 + y^2) + z^2, (gx px + gy py) + gz pz) so that the terms vectorise;
+// added in vertex order: the same bits.
+METRIC_CLONES double mechanical_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, double dt,
+                                       const Vec3f& gravity) {
   if (p.empty()) return 0.0;
-  const Eigen::Vector3d g = gravity.cast<double>();
+  const double gx = gravity.x(), gy = gravity.y(), gz = gravity.z();
   double e = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Eigen::Vector3d v = (xyz(p[i]) - xyz(prev[i])) / dt;
-    e += 0.5 * v.squaredNorm() - g.dot(xyz(p[i]));
-  }
+  chunked(
+      0, p.size(),
+      [&](std::size_t i) {
+        const double px = double(p[i].x()), py = double(p[i].y()), pz = double(p[i].z());
+        const double vx = (px - double(prev[i].x())) / dt, vy = (py - double(prev[i].y())) / dt,
+                     vz = (pz - double(prev[i].z())) / dt;
+        return 0.5 * ((vx * vx + vy * vy) + vz * vz) - ((gx * px + gy * py) + gz * pz);
+      },
+      [&](double term) { e += term; });
   return e / static_cast<double>(p.size());
 }
 

@@ -1,5 +1,7 @@
 #include "reports/verdict.h"
 
+#include "reports/chunked.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -130,16 +132,28 @@ Return ReturnTracker::result() const {
   return r;
 }
 
-double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev, const Affine3f& head,
-                               const Affine3f& head_prev, double dt) {
+METRIC_CLONES double relative_kinetic_energy(std::span<const Vec4f> p, std::span<const Vec4f> prev,
+                                             const Affine3f& head, const Affine3f& head_prev, double dt) {
   // Hair carried rigidly by the head scores 0, so a walk's steady translation is not
-  // motion of the hair; a whip is.
+  // motion of the hair; a whip is. Each vertex's |p - carry prev|^2 in float as Eigen's
+  // Affine3f product and Vector3f squaredNorm compute it, written out in their order
+  // (t + ((m0 a + m1 b) + m2 c), x^2 + (y^2 + z^2)) so that the terms vectorise; added in
+  // vertex order: the same bits.
   const Affine3f carry = head * head_prev.inverse();
+  const Eigen::Matrix3f m = carry.linear();
+  const Vec3f t = carry.translation();
   double sum = 0.0;
-  for (std::size_t v = 0; v < p.size(); ++v) {
-    const Vec3f d = p[v].head<3>() - carry * Vec3f(prev[v].head<3>());
-    sum += static_cast<double>(d.squaredNorm());
-  }
+  metrics::chunked(
+      0, p.size(),
+      [&](std::size_t i) {
+        const float a = prev[i].x(), b = prev[i].y(), c = prev[i].z();
+        const float qx = t.x() + ((m(0, 0) * a + m(0, 1) * b) + m(0, 2) * c);
+        const float qy = t.y() + ((m(1, 0) * a + m(1, 1) * b) + m(1, 2) * c);
+        const float qz = t.z() + ((m(2, 0) * a + m(2, 1) * b) + m(2, 2) * c);
+        const float dx = p[i].x() - qx, dy = p[i].y() - qy, dz = p[i].z() - qz;
+        return static_cast<double>(dx * dx + (dy * dy + dz * dz));
+      },
+      [&](double term) { sum += term; });
   return p.empty() ? 0.0 : sum / (2.0 * dt * dt * static_cast<double>(p.size()));
 }
 

@@ -131,6 +131,42 @@ TEST(Metrics, VectorLoopsGiveTheSerialBits) {
     }
   }
 
+  // The divergence check's mechanical energy and the settle check's kinetic energy
+  // relative to the head, on the same poses and the two-vertex strand, with the previous
+  // frame's positions moved by a few millimetres in every direction and the head moving
+  // from one pose to the next.
+  for (int k = 0; k < 400; ++k) {
+    auto pose = [](float a) -> Affine3f {
+      return Eigen::Translation3f(0.01f * std::sin(a), -0.02f, 0.03f * std::cos(3.0f * a)) *
+             Eigen::AngleAxisf(a, Vec3f(std::sin(2.0f * a), 1.0f, -0.2f).normalized());
+    };
+    const float a = 0.37f * static_cast<float>(k);
+    const Affine3f head = pose(a), head_prev = pose(a - 0.05f);
+    const double dt = 1.0 / (60.0 * (1 + k % 3));
+    const Vec3f gravity(0.01f * static_cast<float>(k % 5), -9.81f, 0.3f);
+    const Eigen::Vector3d g = gravity.cast<double>();
+    for (const std::vector<Vec4f>& q : {p, perturbed(pair)}) {
+      std::vector<Vec4f> before = q;
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        const float u = static_cast<float>(i);
+        before[i].head<3>() += 0.003f * Vec3f(std::sin(0.7f * a + u), std::cos(1.3f * a + 2.0f * u), std::sin(2.1f * a - u));
+      }
+      double energy = 0.0, kinetic = 0.0;
+      const Affine3f carry = head * head_prev.inverse();
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        const Eigen::Vector3d v = (xyz(q[i]) - xyz(before[i])) / dt;
+        energy += 0.5 * v.squaredNorm() - g.dot(xyz(q[i]));
+        const Vec3f d = q[i].head<3>() - carry * Vec3f(before[i].head<3>());
+        kinetic += static_cast<double>(d.squaredNorm());
+      }
+      ASSERT_EQ(metrics::mechanical_energy(q, before, dt, gravity), energy / static_cast<double>(q.size()))
+          << "pose " << k << ", " << q.size() << " vertices";
+      ASSERT_EQ(verdict::relative_kinetic_energy(q, before, head, head_prev, dt),
+                kinetic / (2.0 * dt * dt * static_cast<double>(q.size())))
+          << "pose " << k << ", " << q.size() << " vertices";
+    }
+  }
+
   // Five spheres (four share a pass, then one): the last reaches deepest into the hair.
   const std::vector<Vec4f> spheres = {Vec4f(0.1f, 0.1f, 0.1f, 0.05f), Vec4f(0.5f, 0.2f, 0.1f, 0.03f),
                                       Vec4f(5.0f, 0.0f, 0.0f, 0.1f), Vec4f(0.3f, 0.14f, 0.2f, 0.08f),
