@@ -236,12 +236,14 @@ TEST(Probe, CascadeGrowsAtSixteenNodesOnlyWithFixedReferenceNodes) {
 TEST(Verdict, CascadeOnIdleRestsAndItsFixedReferenceNodesAreUnstable) {
   const Scenario sc = idle_with(16);
   ThreadPool pool(2);
+  AtRestCache at_rest;  // the runs with and without skipping share their probes and twins
   std::vector<RunRecord> runs[2][2];  // [fixed reference nodes][skip]
   for (int fixed = 0; fixed < 2; ++fixed)
     for (int skip = 0; skip < 2; ++skip) {
       RunOptions opt;
       opt.models = {"halen_cascade", "han_m1"};
       opt.skip_inert = skip == 1;
+      opt.at_rest = &at_rest;
       opt.overrides = {{"halen_cascade", "nodes", 16}};
       if (fixed) opt.overrides.push_back({"halen_cascade", "reactions", 0});
       runs[fixed][skip] = run_scenario(sc, opt, pool);

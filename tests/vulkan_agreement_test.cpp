@@ -2,6 +2,7 @@
 // shipped scenario (slow on lavapipe: label slow). Method 3 on shake is in vulkan_test.
 #include "vulkan_support.h"
 
+#include "harness/at_rest_cache.h"
 #include "scenarios/groom_gen.h"
 
 namespace hairbench {
@@ -45,12 +46,14 @@ TEST(VulkanAgreement, Method2CurlyShake) {
 // same number, RMS over vertices / L-bar, every frame).
 TEST(VulkanModels, StableOnEveryBuiltinScenario) {
   HAIRBENCH_REQUIRE_VULKAN();
+  AtRestCache at_rest;  // the scenarios on one groom share their probes and twins, as in compare
   for (const std::filesystem::path& file : test::procedural_builtin_scenarios()) {
     const std::string name = file.stem().string();
     const Scenario sc = test::builtin(name, 50);
     for (const char* m : {"han_m1", "han_m2", "han_m3"}) {
       ThreadPool pool(2);
       RunOptions opt;
+      opt.at_rest = &at_rest;
       opt.models = {std::string(m) + "_vk"};
       opt.reference = m;
       opt.frames = 150;
