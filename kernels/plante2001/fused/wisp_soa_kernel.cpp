@@ -161,6 +161,10 @@ struct Block {
 };
 
 // wisp_forces_and_velocities for a block (see there for the physics, §3.2, §3.3, §5.1).
+// Its F3 temporaries are not const: in this function GCC 12's scalar replacement keeps
+// const F3 locals in memory ("a store to a read-only decl" in -fdump-tree-sra-details),
+// and then not one of its lane loops is vectorised (-fopt-info-vec-missed: "more than one
+// data ref in stmt"); without const every one of them is.
 void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const WispParams& p,
                 const Eigen::Matrix3f& head_rot, const Vec3f& gravity, const Wind& wind, float h) {
   Block blk(s, wisps, count);
@@ -184,17 +188,17 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   blk.load(rdot, s.rdot, Q);
   int* bad = blk.bad;
 
-  const F3 g{gravity.x(), gravity.y(), gravity.z()};
+  F3 g{gravity.x(), gravity.y(), gravity.z()};
   const Vec3f wind_v = wind.acceleration();
-  const F3 wa{wind_v.x(), wind_v.y(), wind_v.z()};
+  F3 wa{wind_v.x(), wind_v.y(), wind_v.z()};
   const bool windy = wind.active();
   for (int i = 0; i < n; ++i) {
     LANES {
       F3 a = sub(g, mul(p.air_drag, v[i].get(l)));
       if (windy && i > 0) {
-        const F3 d = sub(x[i].get(l), x[i - 1].get(l));
+        F3 d = sub(x[i].get(l), x[i - 1].get(l));
         const float n2 = dot(d, d);
-        const F3 t = n2 > 1e-24f ? quot(d, std::sqrt(n2)) : F3{0.0f, 0.0f, 0.0f};
+        F3 t = n2 > 1e-24f ? quot(d, std::sqrt(n2)) : F3{0.0f, 0.0f, 0.0f};
         a = add(a, sub(wa, mul(dot(wa, t), t)));
       }
       acc[i].set(l, a);
@@ -204,13 +208,13 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   LANES seg_len[l] = seg_inv_len[l] = 0.0f;
   for (int i = 1; i < n; ++i) {
     LANES {
-      const F3 d = sub(x[i].get(l), x[i - 1].get(l));
+      F3 d = sub(x[i].get(l), x[i - 1].get(l));
       const float len = std::sqrt(dot(d, d));
       seg_len[i * W + l] = len;
       bad[l] |= !(len > 0.0f);
       const float inv_len = 1.0f / len;
       seg_inv_len[i * W + l] = inv_len;
-      const F3 t = mul(inv_len, d);
+      F3 t = mul(inv_len, d);
       seg_t[i].set(l, t);
       const float f = seg_mass[i * W + l] * (p.axial_stiffness * (len - rest_len[i * W + l]) +
                                              p.axial_damping * dot(sub(v[i].get(l), v[i - 1].get(l)), t));
@@ -227,22 +231,22 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
     for (int i = 2; i < n; ++i) {
       float cos_angle[W];
       LANES {
-        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+        F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
         axis[l] = cross(t_prev, t);
         sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
         cos_angle[l] = dot(t_prev, t);
         angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], cos_angle[l]) : 0.0f;
       }
       LANES {
-        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
+        F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l);
         const bool bends = sin_angle[l] > 1e-7f;
         const float c = cos_angle[l];
         const float q = p.bending_stiffness * (angle[l] - rest_bend[i * W + l]) * bend_scale[i * W + l] / sin_angle[l];
-        const F3 zero{0.0f, 0.0f, 0.0f};
-        const F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(t_prev, mul(c, t))), zero);
-        const F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], sub(mul(c, t_prev), t)), zero);
-        const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
-        const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
+        F3 zero{0.0f, 0.0f, 0.0f};
+        F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(t_prev, mul(c, t))), zero);
+        F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], sub(mul(c, t_prev), t)), zero);
+        F3 dv = sub(v[i].get(l), v[i - 1].get(l));
+        F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
         acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
         acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
         acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
@@ -264,17 +268,17 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       for (int i = 1; i < n; ++i) {
         const V3& prev = i > 1 ? seg_t[i - 1] : root_t;
         LANES {
-          const F3 t = seg_t[i].get(l), prev_t = prev.get(l), ul = u.get(l);
+          F3 t = seg_t[i].get(l), prev_t = prev.get(l), ul = u.get(l);
           const float c = dot(prev_t, t);
           bad[l] |= 1.0f + c < 1e-6f;
-          const F3 k_axis = cross(prev_t, t);
-          const F3 kap = mul(1.0f / (1.0f + c), k_axis);
+          F3 k_axis = cross(prev_t, t);
+          F3 kap = mul(1.0f / (1.0f + c), k_axis);
           kappa[i].set(l, kap);
-          const F3 turned = add(add(mul(c, ul), cross(k_axis, ul)), mul(dot(k_axis, ul), kap));
-          const F3 normal = sub(turned, mul(dot(turned, t), t));
+          F3 turned = add(add(mul(c, ul), cross(k_axis, ul)), mul(dot(k_axis, ul), kap));
+          F3 normal = sub(turned, mul(dot(turned, t), t));
           const float n2 = dot(normal, normal);
           bad[l] |= !(n2 > 1e-24f);
-          const F3 ui = mul(1.0f / std::sqrt(n2), normal);
+          F3 ui = mul(1.0f / std::sqrt(n2), normal);
           u.set(l, ui);
           bishop_u[i].set(l, ui);
         }
@@ -283,24 +287,24 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
     for (int k = 0; k < n * W; ++k) twist_load[k] = 0.0f;
     for (int i = 2; i < n; ++i) {
       LANES {
-        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), u = bishop_u[i - 1].get(l);
-        const F3 b = bl[i].get(l);
-        const F3 target = add(add(mul(b.x, u), mul(b.y, cross(t_prev, u))), mul(b.z, t_prev));
+        F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), u = bishop_u[i - 1].get(l);
+        F3 b = bl[i].get(l);
+        F3 target = add(add(mul(b.x, u), mul(b.y, cross(t_prev, u))), mul(b.z, t_prev));
         axis[l] = cross(target, t);
         sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
         angle[l] = sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(target, t)) : 0.0f;
         bl[i].set(l, target);  // the target from here on
       }
       LANES {
-        const F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), target = bl[i].get(l);
+        F3 t = seg_t[i].get(l), t_prev = seg_t[i - 1].get(l), target = bl[i].get(l);
         const bool bends = sin_angle[l] > 1e-7f;
         const float q = p.bending_stiffness * angle[l] * bend_scale[i * W + l] / sin_angle[l];
-        const F3 zero{0.0f, 0.0f, 0.0f};
-        const F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(target, mul(dot(target, t), t))), zero);
-        const F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], cross(t_prev, axis[l])), zero);
+        F3 zero{0.0f, 0.0f, 0.0f};
+        F3 fk = pick(bends, mul(q * seg_inv_len[i * W + l], sub(target, mul(dot(target, t), t))), zero);
+        F3 fk2 = pick(bends, mul(q * seg_inv_len[(i - 1) * W + l], cross(t_prev, axis[l])), zero);
         twist_load[(i - 1) * W + l] = bends ? -q * dot(t_prev, axis[l]) : 0.0f;
-        const F3 dv = sub(v[i].get(l), v[i - 1].get(l));
-        const F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
+        F3 dv = sub(v[i].get(l), v[i - 1].get(l));
+        F3 damp = mul(p.bending_damping * seg_mass[i * W + l], sub(dv, mul(dot(dv, t), t)));
         acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], sub(fk, damp))));
         acc[i - 2].set(l, add(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fk2)));
         acc[i - 1].set(l, sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], sub(add(fk, fk2), damp))));
@@ -317,18 +321,18 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
       for (int i = n - 1; i > 1; --i) {
         LANES {
           load[l] += twist_load[i * W + l];
-          const F3 kap = kappa[i].get(l);
-          const F3 fn = mul(load[l] * seg_inv_len[i * W + l], kap);
-          const F3 fp = mul(load[l] * seg_inv_len[(i - 1) * W + l], kap);
+          F3 kap = kappa[i].get(l);
+          F3 fn = mul(load[l] * seg_inv_len[i * W + l], kap);
+          F3 fp = mul(load[l] * seg_inv_len[(i - 1) * W + l], kap);
           acc[i].set(l, add(acc[i].get(l), mul(inv_mass[i * W + l], fn)));
-          const F3 ai1 = sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], fn));
+          F3 ai1 = sub(acc[i - 1].get(l), mul(inv_mass[(i - 1) * W + l], fn));
           acc[i - 1].set(l, add(ai1, mul(inv_mass[(i - 1) * W + l], fp)));
           acc[i - 2].set(l, sub(acc[i - 2].get(l), mul(inv_mass[(i - 2) * W + l], fp)));
         }
       }
       LANES {
         load[l] += twist_load[W + l];
-        const F3 fn = mul(load[l] * seg_inv_len[W + l], kappa[1].get(l));
+        F3 fn = mul(load[l] * seg_inv_len[W + l], kappa[1].get(l));
         acc[1].set(l, add(acc[1].get(l), mul(inv_mass[W + l], fn)));
         acc[0].set(l, sub(acc[0].get(l), mul(inv_mass[l], fn)));
       }
@@ -351,7 +355,7 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   if (any_tip) {
     const int i = n - 1;  // the pinned tip; node i - 1 takes the spring
     LANES {
-      const F3 t = seg_t[i].get(l);
+      F3 t = seg_t[i].get(l);
       axis[l] = cross(t, tip_target[l]);
       sin_angle[l] = std::sqrt(dot(axis[l], axis[l]));
       angle[l] = tip[l] && sin_angle[l] > 1e-7f ? atan2_upper(sin_angle[l], dot(tip_target[l], t)) : 0.0f;
@@ -359,13 +363,13 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
     LANES {
       const float len = seg_len[i * W + l], l0 = rest_len[i * W + l], m = seg_mass[i * W + l];
       const float im = inv_mass[(i - 1) * W + l];
-      const F3 t = seg_t[i].get(l);
+      F3 t = seg_t[i].get(l);
       const float torque = p.bending_stiffness * angle[l] * l0 * l0 * m;
-      const F3 spring = mul((torque / len) * im, cross(quot(axis[l], sin_angle[l]), t));
-      const F3 before = acc[i - 1].get(l);
-      const F3 turned = sin_angle[l] > 1e-7f ? sub(before, spring) : before;
-      const F3 dv = sub(v[i - 1].get(l), v[i].get(l));
-      const F3 damped = sub(turned, mul((p.bending_damping * m) * im, sub(dv, mul(dot(dv, t), t))));
+      F3 spring = mul((torque / len) * im, cross(quot(axis[l], sin_angle[l]), t));
+      F3 before = acc[i - 1].get(l);
+      F3 turned = sin_angle[l] > 1e-7f ? sub(before, spring) : before;
+      F3 dv = sub(v[i - 1].get(l), v[i].get(l));
+      F3 damped = sub(turned, mul((p.bending_damping * m) * im, sub(dv, mul(dot(dv, t), t))));
       acc[i - 1].set(l, pick(tip[l] != 0, damped, before));
     }
   }
@@ -375,10 +379,10 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
     LANES {
       const bool is_free = free[i * W + l] != 0.0f;
       const float r0 = r_rest[i * W + l];
-      const F3 frame_acc = sub(g, acc[i].get(l));
-      const F3 u1 = e1[i].get(l), u2 = e2[i].get(l);
-      const F3 dirs[Q] = {u1, u2, {-u1.x, -u1.y, -u1.z}, {-u2.x, -u2.y, -u2.z}};
-      const F3 vel = v[i].get(l);
+      F3 frame_acc = sub(g, acc[i].get(l));
+      F3 u1 = e1[i].get(l), u2 = e2[i].get(l);
+      F3 dirs[Q] = {u1, u2, {-u1.x, -u1.y, -u1.z}, {-u2.x, -u2.y, -u2.z}};
+      F3 vel = v[i].get(l);
       F3 reaction{0.0f, 0.0f, 0.0f};
       float ra_[Q], rd_[Q], out[Q];
       EACH_Q {
@@ -413,7 +417,7 @@ void velocities(WispSystem& s, const std::uint32_t* wisps, int count, const Wisp
   for (int i = 0; i < n; ++i) {
     LANES {
       const bool is_free = free[i * W + l] != 0.0f;
-      const F3 vi = v[i].get(l);
+      F3 vi = v[i].get(l);
       v[i].set(l, pick(is_free, add(vi, mul(h, acc[i].get(l))), vi));
     }
   }
