@@ -246,6 +246,48 @@ TEST(MullerFtl, Deterministic) {
   EXPECT_EQ(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(Vec4f)), 0);
 }
 
+// follow_the_leader over strands side by side gives each strand the bits of its pass
+// alone: strands of different lengths (one longer than the rest, so the others stop
+// early), a pin mid-strand, a free root, two inputs (regions) and spheres the strands
+// fall through, over steps of a moving head.
+TEST(MullerFtl, StrandsSideBySideGiveTheBitsOfEachAlone) {
+  std::vector<Strand> alone, together;
+  for (int k = 0; k < 5; ++k) {
+    std::vector<Vec4f> rest = k == 3 ? curl(23) : line(6 + 3 * k, Vec3f(0.01f * k, 0.1f, 0.0f),
+                                                       Vec3f(1.0f, 0.2f * k, 0.3f), 0.25f, k == 4 ? 0 : 1);
+    if (k == 2) rest[5].w() = 0.0f;
+    alone.emplace_back(rest);
+    together.emplace_back(rest);
+  }
+  muller::StepInput in[2] = {input(0.9f), input(0.5f)};
+  const std::vector<Vec4f> spheres = {Vec4f(0.05f, 0.02f, 0.0f, 0.08f), Vec4f(0.15f, 0.05f, 0.05f, 0.05f)};
+  for (muller::StepInput& i : in) i.spheres = spheres;
+  int collided = 0;
+  for (int step = 1; step <= 60; ++step) {
+    for (muller::StepInput& i : in) i.head = pose(0.02f * static_cast<float>(step), Vec3f::UnitZ(), Vec3f::Zero());
+    std::vector<muller::FtlStrand> group;
+    for (std::size_t k = 0; k < alone.size(); ++k) {
+      const muller::StepInput& ik = in[k % 2];
+      for (Strand* s : {&alone[k], &together[k]}) muller::predict(s->x, s->v, s->rest, ik, s->p);
+      muller::follow_the_leader(alone[k].p, alone[k].d, alone[k].rest, alone[k].rest_length, ik);
+      Strand& t = together[k];
+      group.push_back({t.p, t.d, t.rest, t.rest_length, &ik});
+    }
+    muller::follow_the_leader(group);
+    for (std::size_t k = 0; k < alone.size(); ++k) {
+      const muller::StepInput& ik = in[k % 2];
+      ASSERT_EQ(std::memcmp(alone[k].p.data(), together[k].p.data(), alone[k].p.size() * sizeof(Vec4f)), 0)
+          << "strand " << k << " step " << step;
+      ASSERT_EQ(std::memcmp(alone[k].d.data(), together[k].d.data(), alone[k].d.size() * sizeof(Vec4f)), 0)
+          << "strand " << k << " step " << step;
+      for (const Vec4f& p : alone[k].p)
+        collided += (p.head<3>() - spheres[0].head<3>()).norm() < spheres[0].w() + 1e-4f;
+      for (Strand* s : {&alone[k], &together[k]}) muller::update_velocity(s->x, s->v, s->p, s->d, ik);
+    }
+  }
+  EXPECT_GT(collided, 0) << "no vertex met a sphere: the test would not reach the collisions";
+}
+
 // The plugin ABI's head is 4x4 column-major (translation in elements 12-14).
 TEST(MullerFtl, HeadTransformReadsTheAbisColumnMajorMatrix) {
   const Affine3f a = pose(0.3f, Vec3f::UnitY(), Vec3f(1.0f, 2.0f, 3.0f));

@@ -1,5 +1,6 @@
 #include "kernels/muller2012/ftl_kernels.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hairbench::kernels::muller {
@@ -11,7 +12,9 @@ namespace {
 constexpr int kPushPasses = 4;
 
 // `inline` raises GCC's inlining budget for it: at -O2 it was left a call, and the whole
-// step ran 2.4 times slower (71 against 30 ns a vertex).
+// step ran 2.4 times slower (71 against 30 ns a vertex). follow, onto_contact_circle and
+// collide are `inline` too, so that the FTL pass over strands side by side (below) is one
+// loop body without calls, which the core can overlap from strand to strand.
 inline Vec3f xyz(const Vec4f& v) { return v.head<3>(); }
 
 // The edge a vertex meets the wind with: the one into it; the root's is the one out of it.
@@ -31,8 +34,8 @@ Vec3f normal_wind(const Vec3f& wind, const Vec3f& edge) {
 
 // §3: the point at distance `length` from `leader` in the direction of `target`. A target
 // on the leader gives no direction; the vertex's rest edge under the head's rotation does.
-Vec3f follow(const Vec3f& leader, const Vec3f& target, float length, std::span<const Vec4f> rest,
-             std::size_t i, const Affine3f& head) {
+inline Vec3f follow(const Vec3f& leader, const Vec3f& target, float length, std::span<const Vec4f> rest,
+                    std::size_t i, const Affine3f& head) {
   const Vec3f dir = target - leader;
   const float len = dir.norm();
   if (len > 0.0f) return leader + dir * (length / len);
@@ -69,7 +72,7 @@ void push_out(Vec3f& q, std::span<const Vec4f> spheres) {
 // Where the whole length sphere lies inside, the vertex goes to its point farthest from
 // the centre; where the two spheres do not meet, q can be inside only by rounding and
 // stays.
-Vec3f onto_contact_circle(const Vec3f& leader, const Vec3f& q, float length, const Vec4f& s) {
+inline Vec3f onto_contact_circle(const Vec3f& leader, const Vec3f& q, float length, const Vec4f& s) {
   const Vec3f axis = xyz(s) - leader;
   const float dist = axis.norm();
   if (!(dist > 0.0f) || !(length > 0.0f)) return q;
@@ -87,7 +90,7 @@ Vec3f onto_contact_circle(const Vec3f& leader, const Vec3f& q, float length, con
 }
 
 // Ours: the collision step inside the FTL pass (after §3 placed q at its rest length).
-Vec3f collide(const Vec3f& leader, Vec3f q, float length, std::span<const Vec4f> spheres) {
+inline Vec3f collide(const Vec3f& leader, Vec3f q, float length, std::span<const Vec4f> spheres) {
   for (int pass = 0; pass < kPushPasses; ++pass) {
     bool moved = false;
     for (const Vec4f& s : spheres) {
@@ -130,27 +133,43 @@ void predict(std::span<const Vec4f> x, std::span<const Vec4f> v, std::span<const
   }
 }
 
+namespace {
+
+// Vertex i of follow_the_leader's pass; every vertex before it is placed.
+inline void follow_vertex(std::span<Vec4f> p, std::span<Vec4f> d, std::span<const Vec4f> rest,
+                          std::span<const float> rest_length, const StepInput& in, std::size_t i) {
+  d[i].setZero();
+  if (p[i].w() == 0.0f) return;  // pinned: a leader FTL never moves
+  Vec3f q = xyz(p[i]);
+  if (i == 0) {
+    // A free root has no leader: FTL leaves it where it was predicted, the spheres
+    // alone move it.
+    push_out(q, in.spheres);
+    p[i].head<3>() = q;
+    return;
+  }
+  const Vec3f leader = xyz(p[i - 1]);
+  const Vec3f placed = follow(leader, q, rest_length[i], rest, i, in.head);
+  // d_i is the FTL move only, not the collision's: the sphere, not the edge, pushes a
+  // vertex out, so nothing of that push is the leader's to take back in §4's velocity
+  // term (taking it too bent strands that wrap a moving head twice as much per edge).
+  d[i].head<3>() = placed - q;
+  p[i].head<3>() = in.spheres.empty() ? placed : collide(leader, placed, rest_length[i], in.spheres);
+}
+
+}  // namespace
+
 void follow_the_leader(std::span<Vec4f> p, std::span<Vec4f> d, std::span<const Vec4f> rest,
                        std::span<const float> rest_length, const StepInput& in) {
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    d[i].setZero();
-    if (p[i].w() == 0.0f) continue;  // pinned: a leader FTL never moves
-    Vec3f q = xyz(p[i]);
-    if (i == 0) {
-      // A free root has no leader: FTL leaves it where it was predicted, the spheres
-      // alone move it.
-      push_out(q, in.spheres);
-      p[i].head<3>() = q;
-      continue;
-    }
-    const Vec3f leader = xyz(p[i - 1]);
-    const Vec3f placed = follow(leader, q, rest_length[i], rest, i, in.head);
-    // d_i is the FTL move only, not the collision's: the sphere, not the edge, pushes a
-    // vertex out, so nothing of that push is the leader's to take back in §4's velocity
-    // term (taking it too bent strands that wrap a moving head twice as much per edge).
-    d[i].head<3>() = placed - q;
-    p[i].head<3>() = in.spheres.empty() ? placed : collide(leader, placed, rest_length[i], in.spheres);
-  }
+  for (std::size_t i = 0; i < p.size(); ++i) follow_vertex(p, d, rest, rest_length, in, i);
+}
+
+void follow_the_leader(std::span<const FtlStrand> strands) {
+  std::size_t longest = 0;
+  for (const FtlStrand& s : strands) longest = std::max(longest, s.p.size());
+  for (std::size_t i = 0; i < longest; ++i)
+    for (const FtlStrand& s : strands)
+      if (i < s.p.size()) follow_vertex(s.p, s.d, s.rest, s.rest_length, *s.in, i);
 }
 
 void update_velocity(std::span<Vec4f> x, std::span<Vec4f> v, std::span<const Vec4f> p,

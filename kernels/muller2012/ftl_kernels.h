@@ -62,6 +62,20 @@ void predict(std::span<const Vec4f> x, std::span<const Vec4f> v, std::span<const
 void follow_the_leader(std::span<Vec4f> p, std::span<Vec4f> d, std::span<const Vec4f> rest,
                        std::span<const float> rest_length, const StepInput& in);
 
+// One strand's arrays and input, for follow_the_leader over several strands.
+struct FtlStrand {
+  std::span<Vec4f> p, d;
+  std::span<const Vec4f> rest;
+  std::span<const float> rest_length;
+  const StepInput* in = nullptr;
+};
+
+// follow_the_leader on each of `strands`, vertex i of every strand before vertex i + 1 of
+// any. One strand's pass is a chain of dependent square roots and divisions (a vertex
+// waits for its leader), so a core left with one chain idles; strands side by side give
+// it independent work. Each strand gets follow_the_leader's operations: the same bits.
+void follow_the_leader(std::span<const FtlStrand> strands);
+
 // Algorithm 1, velocity update: v_i = (p_i - x_i)/Δt - s_damping d_{i+1}/Δt for a free
 // vertex with a free child; the tip, and a free vertex whose child is pinned, have no
 // correction term (their child was not moved by FTL). Then v *= 1 - damping (ours) and

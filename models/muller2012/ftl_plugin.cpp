@@ -10,6 +10,8 @@
 
 #include "kernels/muller2012/ftl_kernels.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -147,7 +149,9 @@ class FtlModel {
   std::span<Vec4f> strand(std::vector<Vec4f>& a, std::size_t s) const;
   std::span<const float> strand(const std::vector<float>& a, std::size_t s) const;
   template <class Fn>
-  void for_each_strand(int stage, const Fn& fn);
+  void for_each_strand(int stage, const Fn& fn) { for_each(stage, offsets_.size() - 1, fn); }
+  template <class Fn>
+  void for_each(int stage, std::size_t count, const Fn& fn);
 
   hb_host host_;
   std::vector<std::uint32_t> offsets_;
@@ -229,8 +233,18 @@ void FtlModel::substep(const Affine3f& head, const hb_frame& frame, float dt) {
   for_each_strand(HB_STAGE_INTEGRATE, [&](std::size_t s) {
     muller::predict(strand(x_, s), strand(v_, s), strand(rest_, s), in[region_[s]], strand(p_, s));
   });
-  for_each_strand(HB_STAGE_LENGTH, [&](std::size_t s) {
-    muller::follow_the_leader(strand(p_, s), strand(d_, s), strand(rest_, s), strand(rest_length_, s), in[region_[s]]);
+  // Groups of consecutive strands, side by side through the FTL pass (follow_the_leader
+  // over strands: a strand alone is one chain of dependent steps).
+  constexpr std::size_t kGroup = 8;
+  const std::size_t strands = offsets_.size() - 1;
+  for_each(HB_STAGE_LENGTH, (strands + kGroup - 1) / kGroup, [&](std::size_t g) {
+    std::array<muller::FtlStrand, kGroup> group;
+    const std::size_t first = g * kGroup, count = std::min(kGroup, strands - first);
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t s = first + k;
+      group[k] = {strand(p_, s), strand(d_, s), strand(rest_, s), strand(rest_length_, s), &in[region_[s]]};
+    }
+    muller::follow_the_leader(std::span<const muller::FtlStrand>(group.data(), count));
   });
   for_each_strand(HB_STAGE_INTEGRATE, [&](std::size_t s) {
     muller::update_velocity(strand(x_, s), strand(v_, s), strand(p_, s), strand(d_, s), in[region_[s]]);
@@ -260,16 +274,16 @@ std::span<const float> FtlModel::strand(const std::vector<float>& a, std::size_t
   return {a.data() + offsets_[s], offsets_[s + 1] - offsets_[s]};
 }
 
-// fn(s) for every strand through the host's parallel_for, its wall time added to `stage`.
-// The kernels neither throw nor allocate, so nothing leaves the callback.
+// fn(i) for every i < count through the host's parallel_for, its wall time added to
+// `stage`. The kernels neither throw nor allocate, so nothing leaves the callback.
 template <class Fn>
-void FtlModel::for_each_strand(int stage, const Fn& fn) {
+void FtlModel::for_each(int stage, std::size_t count, const Fn& fn) {
   const auto start = std::chrono::steady_clock::now();
   const auto run = [](void* user, std::size_t begin, std::size_t end) noexcept {
     const Fn& f = *static_cast<const Fn*>(user);
     for (std::size_t s = begin; s < end; ++s) f(s);
   };
-  host_.parallel_for(host_.ctx, offsets_.size() - 1, run, const_cast<Fn*>(&fn));
+  host_.parallel_for(host_.ctx, count, run, const_cast<Fn*>(&fn));
   if (host_.stage_time == nullptr) return;
   const std::chrono::duration<double, std::milli> ms = std::chrono::steady_clock::now() - start;
   host_.stage_time(host_.ctx, stage, ms.count());
