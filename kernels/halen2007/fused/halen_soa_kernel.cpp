@@ -427,7 +427,9 @@ inline void own_space(const Space& parent, Space& cur, const float* ax, const fl
   LANES {
     const float ex = bx[l] - ax[l], ey = by[l] - ay[l], ez = bz[l] - az[l];
     const float len = std::sqrt(ex * ex + (ey * ey + ez * ez));
-    const bool own = bs[l] == 1.0f && len > 0.0f;
+    // & rather than &&: a comparison after && is conditional, which under trapping maths
+    // (these kernels keep it) is control flow to GCC, and the loop stays scalar.
+    const bool own = (bs[l] == 1.0f) & (len > 0.0f);
     const float nx = ex / len, ny = ey / len, nz = ez / len;
     float b0, b1, b2;
     bool ok;
@@ -493,7 +495,8 @@ inline void push_bend(const Rows& r, int to, int from, const float* q, const flo
   LANES {
     const float s = q[l] / len[l];
     const float fx = s * kx[l], fy = s * ky[l], fz = s * kz[l];
-    const bool t = on[l] != 0 && iwt[l] != 0.0f, f = on[l] != 0 && iwf[l] != 0.0f;
+    // & rather than &&, as in own_space: so that the loop is vector code.
+    const bool t = (on[l] != 0) & (iwt[l] != 0.0f), f = (on[l] != 0) & (iwf[l] != 0.0f);
     r.ax[ot + l] = t ? r.ax[ot + l] + fx : r.ax[ot + l];
     r.ay[ot + l] = t ? r.ay[ot + l] + fy : r.ay[ot + l];
     r.az[ot + l] = t ? r.az[ot + l] + fz : r.az[ot + l];
