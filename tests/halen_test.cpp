@@ -5,6 +5,7 @@
 #include "harness/probe.h"
 #include "kernels/halen2007/nodes.h"
 #include "kernels/halen2007/reference/halen_kernels.h"
+#include "models/halen2007/step_bounds.h"
 #include "models/registry.h"
 #include "reports/metrics.h"
 #include "scenarios/groom_gen.h"
@@ -984,6 +985,31 @@ TEST(HalenKernels, StiffnessFalloff) {
   EXPECT_FLOAT_EQ(kernels::falloff_stiffness(100.0f, 0.2f, 10.0f, 1), 50.0f);
   EXPECT_FLOAT_EQ(kernels::falloff_stiffness(100.0f, 0.2f, 10.0f, 2), 25.0f);
   EXPECT_FLOAT_EQ(kernels::falloff_stiffness(100.0f, 0.2f, 10.0f, 3), 12.5f);
+}
+
+// cascade_rest_stiffness keeps its last answers: a kept one is the one the measurement
+// gives. The same inputs again give the same bits; the stiffness doubled doubles the
+// springs' modes (the Jacobian is linear in it); a vertex of each strand moved by a
+// millimetre, or a falloff changed, is a new measurement, and the first inputs after them
+// still give the first answer.
+TEST(HalenCascade, RestStiffnessKeptAnswersAreMeasurements) {
+  const ModelInfo* info = find_model("halen_cascade");
+  ASSERT_NE(info, nullptr);
+  Scenario sc = builtin("idle", 1);
+  sc.groom = idle_groom(8, 50);
+  const ParamSet p = resolve_params(*info, sc, {});
+  const ParamSet stiff = resolve_params(*info, sc, {{"halen_cascade", "stiffness", 2.0 * p.get("stiffness", 0)}});
+  const ParamSet falloff =
+      resolve_params(*info, sc, {{"halen_cascade", "falloff_scale", 0.5 * p.get("falloff_scale", 0)}});
+  const double first = halen::cascade_rest_stiffness(sc.groom, p);
+  ASSERT_GT(first, 0.0);
+  EXPECT_EQ(halen::cascade_rest_stiffness(sc.groom, p), first);
+  EXPECT_NEAR(halen::cascade_rest_stiffness(sc.groom, stiff), 2.0 * first, 1e-3 * first);
+  EXPECT_NE(halen::cascade_rest_stiffness(sc.groom, falloff), first);
+  Groom moved = sc.groom;
+  for (std::size_t k = 0; k < moved.strand_count(); ++k) moved.positions[moved.strand_begin(k) + 4].x() += 1e-3f;
+  EXPECT_NE(halen::cascade_rest_stiffness(moved, p), first);
+  EXPECT_EQ(halen::cascade_rest_stiffness(sc.groom, p), first);
 }
 
 }  // namespace

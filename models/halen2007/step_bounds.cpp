@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <deque>
 #include <iomanip>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <span>
 #include <vector>
@@ -99,7 +102,9 @@ StepBound spring_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity) 
   return explicit_spring_bound(g, k, gravity, "k = " + num(k) + " s^-2");
 }
 
-double cascade_rest_stiffness(const Groom& g, const ParamSet& p) {
+namespace {
+
+double measure_rest_stiffness(const Groom& g, const ParamSet& p) {
   namespace k = kernels;
   const auto frames = static_cast<k::CascadeFrames>(p.get_int("frames"));
   const bool reactions = p.get_int("reactions") != 0;
@@ -164,6 +169,53 @@ double cascade_rest_stiffness(const Groom& g, const ParamSet& p) {
     largest = std::max(largest, lambda);
   }
   return largest;
+}
+
+// Everything measure_rest_stiffness reads, exactly: the groom's vertices, strands and
+// regions, and the parameters of each region and of the whole groom.
+struct StiffnessKey {
+  std::vector<Vec4f> positions;
+  std::vector<std::uint32_t> strand_offsets;
+  std::vector<std::uint16_t> strand_region;
+  std::vector<double> params;
+
+  StiffnessKey(const Groom& g, const ParamSet& p)
+      : positions(g.positions), strand_offsets(g.strand_offsets), strand_region(g.strand_region) {
+    params = {static_cast<double>(p.get_int("frames")), static_cast<double>(p.get_int("reactions"))};
+    for (std::size_t r = 0; r < g.region_names.size(); ++r)
+      for (const char* name : {"stiffness", "falloff_scale", "falloff_exponent", "down_fraction"})
+        params.push_back(p.get(name, r));
+  }
+  bool operator==(const StiffnessKey& o) const {
+    return params == o.params && strand_offsets == o.strand_offsets && strand_region == o.strand_region &&
+           positions.size() == o.positions.size() &&
+           std::memcmp(positions.data(), o.positions.data(), positions.size() * sizeof(Vec4f)) == 0;
+  }
+};
+
+}  // namespace
+
+// The measurement is a power iteration of 40 rounds per strand, and a comparison asks for
+// it again and again with the same groom and parameters: for each run, its rest twin and
+// its probes, and for every scenario on the same procedural groom (21 times for the
+// 2,000-strand groom in the default comparison, 0.3 s each on the 2-core box). The last
+// few answers are kept; an answer depends on its inputs alone, so a kept one is the one
+// the measurement would give.
+double cascade_rest_stiffness(const Groom& g, const ParamSet& p) {
+  constexpr std::size_t kKept = 8;
+  static std::mutex mutex;
+  static std::deque<std::pair<StiffnessKey, double>> kept;
+  StiffnessKey key(g, p);
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [k, value] : kept)
+      if (k == key) return value;
+  }
+  const double value = measure_rest_stiffness(g, p);
+  const std::lock_guard<std::mutex> lock(mutex);
+  kept.emplace_front(std::move(key), value);
+  if (kept.size() > kKept) kept.pop_back();
+  return value;
 }
 
 StepBound cascade_bound(const Groom& g, const ParamSet& p, const Vec3f& gravity) {
