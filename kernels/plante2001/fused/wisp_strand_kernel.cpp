@@ -20,10 +20,6 @@ constexpr int W = kLanes;
 constexpr int kSectionFloats = 10;
 static_assert(sizeof(NodeSection) == kSectionFloats * sizeof(float), "NodeSection is read as floats");
 
-F3 section3(const float* p, int i, int at) {
-  return {p[kSectionFloats * i + at], p[kSectionFloats * i + at + 1], p[kSectionFloats * i + at + 2]};
-}
-
 }  // namespace
 
 void strand_points(const WispSystem& s, const NodeSection* sections, const std::uint32_t* node, const Vec4f* coord,
@@ -32,38 +28,56 @@ void strand_points(const WispSystem& s, const NodeSection* sections, const std::
   const float* sec = reinterpret_cast<const float*>(sections);
   const float* cf = coord->data();
   for (std::uint32_t i0 = 0; i0 < n; i0 += W) {
-    float px[W], py[W], pz[W], wt[W];
-    int bad[W];
+    // Each lane's inputs first, copied into rows of one float a lane (the vertex's node k
+    // and its neighbour j are indirect, and GCC does not vectorise such loads), then the
+    // arithmetic on the rows as vector code.
+    alignas(64) float sfrac[W], ca[W], cb[W], cn[W], wk[W], wj[W];
+    alignas(64) float xk[3][W], xj[3][W], sk[kSectionFloats][W], sj[kSectionFloats][W];
     // Lanes past the strand's end repeat its last vertex; their results are dropped.
-#pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
       const int i = static_cast<int>(i0 + l < n ? i0 + l : n - 1);
       const int k = static_cast<int>(node[i]);
-      const float sfrac = cf[4 * i], ca = cf[4 * i + 1], cb = cf[4 * i + 2], cn = cf[4 * i + 3];
-      const int j = sfrac > 0.0f ? k + 1 : sfrac < 0.0f ? k - 1 : k;
-      const float u = std::abs(sfrac);
+      sfrac[l] = cf[4 * i];
+      ca[l] = cf[4 * i + 1];
+      cb[l] = cf[4 * i + 2];
+      cn[l] = cf[4 * i + 3];
+      const int j = sfrac[l] > 0.0f ? k + 1 : sfrac[l] < 0.0f ? k - 1 : k;
+      for (int c = 0; c < 3; ++c) {
+        xk[c][l] = x[3 * k + c];
+        xj[c][l] = x[3 * j + c];
+      }
+      for (int c = 0; c < kSectionFloats; ++c) {
+        sk[c][l] = sec[kSectionFloats * k + c];
+        sj[c][l] = sec[kSectionFloats * j + c];
+      }
+      wk[l] = s.frame_weight[k];
+      wj[l] = s.frame_weight[j];
+    }
+    float px[W], py[W], pz[W], wt[W];
+    int bad[W];
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      const float u = std::abs(sfrac[l]);
       // section_between (wisp_kernels.cpp) from the NodeSections of k and j.
-      const F3 xk = load3(x, k), xj = load3(x, j);
-      const F3 origin = add(xk, mul(u, sub(xj, xk)));
-      const F3 e1k = section3(sec, k, 0), e1j = section3(sec, j, 0);
-      const F3 e2k = section3(sec, k, 3), e2j = section3(sec, j, 3);
+      F3 xkl{xk[0][l], xk[1][l], xk[2][l]}, xjl{xj[0][l], xj[1][l], xj[2][l]};
+      F3 origin = add(xkl, mul(u, sub(xjl, xkl)));
+      F3 e1k{sk[0][l], sk[1][l], sk[2][l]}, e1j{sj[0][l], sj[1][l], sj[2][l]};
+      F3 e2k{sk[3][l], sk[4][l], sk[5][l]}, e2j{sj[3][l], sj[4][l], sj[5][l]};
       int fallback = 0;
-      const F3 e1 = unit(add(e1k, mul(u, sub(e1j, e1k))), fallback);
-      const F3 e2_lerp = add(e2k, mul(u, sub(e2j, e2k)));
-      const F3 e2 = unit(sub(e2_lerp, mul(dot(e2_lerp, e1), e1)), fallback);
-      const F3 nrm = cross(e1, e2);
-      const float* sk = sec + kSectionFloats * k + 6;
-      const float* sj = sec + kSectionFloats * j + 6;
+      F3 e1 = unit(add(e1k, mul(u, sub(e1j, e1k))), fallback);
+      F3 e2_lerp = add(e2k, mul(u, sub(e2j, e2k)));
+      F3 e2 = unit(sub(e2_lerp, mul(dot(e2_lerp, e1), e1)), fallback);
+      F3 nrm = cross(e1, e2);
       // point_in: the scale of the half-axis on the coordinate's side.
       float scale[4];
-      for (int q = 0; q < 4; ++q) scale[q] = lerp(sk[q], sj[q], u);
-      const float a = ca * (ca >= 0.0f ? scale[0] : scale[2]);
-      const float b = cb * (cb >= 0.0f ? scale[1] : scale[3]);
-      const F3 p = add(add(add(origin, mul(a, e1)), mul(b, e2)), mul(cn, nrm));
+      for (int q = 0; q < 4; ++q) scale[q] = lerp(sk[6 + q][l], sj[6 + q][l], u);
+      const float a = ca[l] * (ca[l] >= 0.0f ? scale[0] : scale[2]);
+      const float b = cb[l] * (cb[l] >= 0.0f ? scale[1] : scale[3]);
+      F3 p = add(add(add(origin, mul(a, e1)), mul(b, e2)), mul(cn[l], nrm));
       px[l] = p.x;
       py[l] = p.y;
       pz[l] = p.z;
-      wt[l] = lerp(s.frame_weight[k], s.frame_weight[j], u);
+      wt[l] = lerp(wk[l], wj[l], u);
       bad[l] = fallback;
     }
     const std::uint32_t m = n - i0 < W ? n - i0 : W;
