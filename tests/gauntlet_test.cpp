@@ -121,11 +121,9 @@ Scenario every_nth_guide(Scenario sc, std::uint32_t keep_every) {
     if (g % keep_every != 0) continue;
     const std::uint32_t kept = g / keep_every;
     const auto owner = static_cast<std::uint32_t>(std::upper_bound(begin.begin(), begin.end(), f.anchor[s]) - begin.begin() - 1);
-    std::uint32_t anchor = f.anchor[s] - begin[g] + guides.strand_begin(kept);  // a vertex of its own guide
-    if (owner != g) {
-      const std::uint32_t near = owner / keep_every == kept ? (kept + 1) % kept_count : owner / keep_every;
-      anchor = guides.strand_begin(near);
-    }
+    const std::uint32_t near = owner / keep_every == kept ? (kept + 1) % kept_count : owner / keep_every;
+    const std::uint32_t anchor = owner == g ? f.anchor[s] - begin[g] + guides.strand_begin(kept)  // its own guide's
+                                            : guides.strand_begin(near);
     thin.guide.push_back(kept);
     thin.anchor.push_back(anchor);
     thin.offsets.insert(thin.offsets.end(), f.offsets.begin() + f.follow_offsets[s],

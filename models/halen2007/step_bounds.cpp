@@ -197,10 +197,9 @@ struct StiffnessKey {
 
 // The measurement is a power iteration of 40 rounds per strand, and a comparison asks for
 // it again and again with the same groom and parameters: for each run, its rest twin and
-// its probes, and for every scenario on the same procedural groom (21 times for the
-// 2,000-strand groom in the default comparison, 0.3 s each on the 2-core box). The last
-// few answers are kept; an answer depends on its inputs alone, so a kept one is the one
-// the measurement would give.
+// its probes, and for every scenario on the same procedural groom. The last few answers
+// are kept; an answer depends on its inputs alone, so a kept one is the one the
+// measurement would give.
 double cascade_rest_stiffness(const Groom& g, const ParamSet& p) {
   constexpr std::size_t kKept = 8;
   static std::mutex mutex;

@@ -59,21 +59,21 @@ void strand_points(const WispSystem& s, const NodeSection* sections, const std::
     for (int l = 0; l < W; ++l) {
       const float u = std::abs(sfrac[l]);
       // section_between (wisp_kernels.cpp) from the NodeSections of k and j.
-      F3 xkl{xk[0][l], xk[1][l], xk[2][l]}, xjl{xj[0][l], xj[1][l], xj[2][l]};
-      F3 origin = add(xkl, mul(u, sub(xjl, xkl)));
-      F3 e1k{sk[0][l], sk[1][l], sk[2][l]}, e1j{sj[0][l], sj[1][l], sj[2][l]};
-      F3 e2k{sk[3][l], sk[4][l], sk[5][l]}, e2j{sj[3][l], sj[4][l], sj[5][l]};
+      const F3 xkl{xk[0][l], xk[1][l], xk[2][l]}, xjl{xj[0][l], xj[1][l], xj[2][l]};
+      const F3 origin = add(xkl, mul(u, sub(xjl, xkl)));
+      const F3 e1k{sk[0][l], sk[1][l], sk[2][l]}, e1j{sj[0][l], sj[1][l], sj[2][l]};
+      const F3 e2k{sk[3][l], sk[4][l], sk[5][l]}, e2j{sj[3][l], sj[4][l], sj[5][l]};
       int fallback = 0;
-      F3 e1 = unit(add(e1k, mul(u, sub(e1j, e1k))), fallback);
-      F3 e2_lerp = add(e2k, mul(u, sub(e2j, e2k)));
-      F3 e2 = unit(sub(e2_lerp, mul(dot(e2_lerp, e1), e1)), fallback);
-      F3 nrm = cross(e1, e2);
+      const F3 e1 = unit(add(e1k, mul(u, sub(e1j, e1k))), fallback);
+      const F3 e2_lerp = add(e2k, mul(u, sub(e2j, e2k)));
+      const F3 e2 = unit(sub(e2_lerp, mul(dot(e2_lerp, e1), e1)), fallback);
+      const F3 nrm = cross(e1, e2);
       // point_in: the scale of the half-axis on the coordinate's side.
       float scale[4];
       for (int q = 0; q < 4; ++q) scale[q] = lerp(sk[6 + q][l], sj[6 + q][l], u);
       const float a = ca[l] * (ca[l] >= 0.0f ? scale[0] : scale[2]);
       const float b = cb[l] * (cb[l] >= 0.0f ? scale[1] : scale[3]);
-      F3 p = add(add(add(origin, mul(a, e1)), mul(b, e2)), mul(cn[l], nrm));
+      const F3 p = add(add(add(origin, mul(a, e1)), mul(b, e2)), mul(cn[l], nrm));
       px[l] = p.x;
       py[l] = p.y;
       pz[l] = p.z;
